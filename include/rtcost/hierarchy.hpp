@@ -1,0 +1,190 @@
+#pragma once
+/// \file hierarchy.hpp
+/// The one interface every acceleration structure implements, its named parameters, and the
+/// registry through which the CLI, the cost model and the reports find hierarchies by name.
+///
+/// A hierarchy lives in its own folder `src/hierarchy/<name>/`: a builder, one traversal
+/// template over the counting policy (stats.hpp), and a registration. Nothing else changes when
+/// a hierarchy is added.
+
+#include <functional>
+#include <map>
+#include <memory>
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rtcost/scene.hpp"
+#include "rtcost/stats.hpp"
+
+namespace rtcost {
+
+/// What a query asks for.
+enum class Query {
+    Closest,  ///< nearest hit in (tmin, tmax)
+    Any,      ///< any hit in (tmin, tmax) (occlusion); the hit reported is the first one found
+};
+
+/// One node of a hierarchy as the cost model sees it (see the cost-model docs): a region, an
+/// optional bounding volume tested before the node is entered, an optional separating plane, the
+/// operations one visit costs, and either children or the primitives of a leaf.
+struct ModelNode {
+    Box3 region;                 ///< R(A): the node's box (a BVH node's bounding box)
+    bool has_bv = false;         ///< a box test against `region` precedes entering the node
+    std::int8_t axis = -1;       ///< separating plane axis, -1 for none (BVH)
+    float plane = 0;             ///< separating plane position on `axis`
+    std::uint32_t first = 0;     ///< first child (in ModelTree::nodes) or first primitive (in ModelTree::prims)
+    std::uint32_t count = 0;     ///< number of children, or of primitives for a leaf
+    bool leaf = true;
+    int depth = 0;               ///< root at 0
+};
+
+/// A hierarchy flattened for the model: `nodes[0]` is the root; the children of a node are
+/// contiguous. Binary for space subdivisions; a BVH node may have more than two children
+/// (Goldsmith and Salmon's trees are n-ary), each entered through its own box test.
+struct ModelTree {
+    std::vector<ModelNode> nodes;
+    std::vector<std::uint32_t> prims;  ///< leaf primitive references
+};
+
+/// One named build parameter, declared by the hierarchy with its default and help text.
+struct ParamSpec {
+    std::string name;
+    std::string default_value;
+    std::string help;
+};
+
+/// Validated parameter values of one build (`--set key=value`). Accessors throw InputError
+/// naming the parameter when a value does not parse.
+class Params {
+public:
+    Params() = default;
+    /// Checks every `key=value` against `specs` (unknown keys are an error) and fills defaults.
+    Params(const std::vector<ParamSpec>& specs, const std::vector<std::string>& assignments);
+
+    const std::string& str(const std::string& key) const;
+    long long integer(const std::string& key, long long lo, long long hi) const;
+    double real(const std::string& key, double lo, double hi) const;
+    bool flag(const std::string& key) const;
+    /// The value must be one of `choices`.
+    const std::string& choice(const std::string& key, std::initializer_list<std::string_view> choices) const;
+    const std::map<std::string, std::string>& values() const { return values_; }
+
+private:
+    std::map<std::string, std::string> values_;
+};
+
+/// An acceleration structure over a scene. Thread-safe for concurrent queries.
+class Hierarchy {
+public:
+    virtual ~Hierarchy() = default;
+
+    /// Registered name, e.g. "bvh-sah".
+    virtual std::string_view name() const = 0;
+
+    /// Closest hit of `ray`; `hit.prim` is -1 on a miss. `hit.ng` is not filled (see
+    /// Scene::complete_hit). The counting overload adds this ray's operations to `counters`.
+    virtual void closest(const Ray& ray, Hit& hit) const = 0;
+    virtual void closest(const Ray& ray, Hit& hit, RayCounters& counters) const = 0;
+    /// Any-hit (occlusion) query: true when some primitive is hit in (tmin, tmax); `hit` then
+    /// holds the first hit found (not necessarily the closest).
+    virtual bool any(const Ray& ray, Hit& hit) const = 0;
+    virtual bool any(const Ray& ray, Hit& hit, RayCounters& counters) const = 0;
+
+    /// Structural statistics (N_IN, N_V, N_EV, N_OIV, depth, bytes, build seconds).
+    StructureStats structure() const {
+        StructureStats s = compute_structure();
+        s.seconds = build_seconds_;
+        return s;
+    }
+
+    const Scene& scene() const { return *scene_; }
+
+    /// The structure as the cost model's tree. Empty for hierarchies the model cannot see into
+    /// (embree).
+    virtual ModelTree model_tree() const { return {}; }
+
+protected:
+    explicit Hierarchy(const Scene& scene) : scene_(&scene) {}
+    /// Everything of StructureStats but `seconds`, which build_hierarchy measures.
+    virtual StructureStats compute_structure() const = 0;
+    const Scene* scene_;
+
+private:
+    friend std::unique_ptr<Hierarchy> build_hierarchy(const Scene&, std::string_view,
+                                                      const std::vector<std::string>&);
+    double build_seconds_ = 0;
+};
+
+/// Implements the four query overloads of Hierarchy from one traversal template of `Derived`:
+///   template <class C, Query Q> bool trace(const Ray&, Hit&, C& counting) const;
+/// which returns true on a hit. This is how counting stays a compile-time policy.
+template <class Derived>
+class HierarchyImpl : public Hierarchy {
+public:
+    using Hierarchy::Hierarchy;
+    void closest(const Ray& ray, Hit& hit) const final {
+        NoCount c;
+        self().template trace<NoCount, Query::Closest>(ray, hit, c);
+    }
+    void closest(const Ray& ray, Hit& hit, RayCounters& counters) const final {
+        Count c{counters};
+        ++counters.rays;
+        self().template trace<Count, Query::Closest>(ray, hit, c);
+    }
+    bool any(const Ray& ray, Hit& hit) const final {
+        NoCount c;
+        return self().template trace<NoCount, Query::Any>(ray, hit, c);
+    }
+    bool any(const Ray& ray, Hit& hit, RayCounters& counters) const final {
+        Count c{counters};
+        ++counters.rays;
+        return self().template trace<Count, Query::Any>(ray, hit, c);
+    }
+
+private:
+    const Derived& self() const { return static_cast<const Derived&>(*this); }
+};
+
+/// Tests primitive `id` against `ray` and, when it is hit nearer than `hit.t`, records it.
+/// Counts one primitive test of the primitive's kind. Shared by every traversal's leaves.
+template <class C>
+inline bool test_prim(const Scene& scene, std::uint32_t id, const Ray& ray, Hit& hit, C& counting) {
+    counting.prim(scene.kind(id));
+    Ray r = ray;
+    r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
+    float t;
+    if (scene.intersect(id, r, t)) {
+        hit.t = t;
+        hit.prim = static_cast<std::int32_t>(id);
+        return true;
+    }
+    return false;
+}
+
+/// A registered hierarchy: its name, a one-line description, its parameters and its builder.
+struct HierarchyInfo {
+    std::string name;
+    std::string description;
+    std::vector<ParamSpec> params;
+    std::function<std::unique_ptr<Hierarchy>(const Scene&, const Params&)> build;
+};
+
+/// All registered hierarchies, sorted by name.
+std::vector<const HierarchyInfo*> hierarchies();
+/// The hierarchy called `name`, or nullptr.
+const HierarchyInfo* find_hierarchy(std::string_view name);
+
+/// Builds `name` over `scene` with `--set` assignments; fills `structure().seconds`. Throws
+/// InputError for an unknown name or bad parameters. The scene must outlive the result.
+std::unique_ptr<Hierarchy> build_hierarchy(const Scene& scene, std::string_view name,
+                                           const std::vector<std::string>& assignments = {});
+
+/// Registers a hierarchy at static-initialisation time; used once in each hierarchy's folder:
+///   static const rtcost::Registration reg{{"bvh-sah", "...", {...}, builder}};
+struct Registration {
+    explicit Registration(HierarchyInfo info);
+};
+
+}  // namespace rtcost

@@ -1,0 +1,51 @@
+#pragma once
+/// \file io.hpp
+/// Reading scenes (NFF, meshes through assimp, built-in generators) and the binary ray and hit
+/// files. Every reader throws rtcost::InputError on bad input; none leaves a partial result.
+
+#include <span>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rtcost/error.hpp"
+#include "rtcost/scene.hpp"
+
+namespace rtcost {
+
+/// Loads a scene from `spec`: a file path (`.nff` read by rtcost's NFF reader, anything else
+/// through assimp) or `builtin:NAME[:level]` (see builtin_scene). Throws InputError.
+Scene load_scene(std::string_view spec);
+
+/// Reads an NFF scene from a file; `name` is used in error messages.
+Scene read_nff_file(const std::string& path);
+/// Reads NFF text; `name` is used in error messages.
+Scene read_nff(std::string_view text, const std::string& name);
+/// Reads a mesh file through assimp (triangulated; ids in mesh order then face order).
+Scene read_mesh(const std::string& path);
+
+/// Built-in scenes: `balls` (sphereflake on a ground polygon, default level 4 = 7,382
+/// primitives) and `tetra` (recursive tetrahedron, default level 6 = 4,096 triangles).
+/// `level` < 0 selects the default. Throws InputError for an unknown name or a bad level.
+Scene builtin_scene(std::string_view name, int level = -1);
+
+/// Names of the built-in scenes.
+std::vector<std::string> builtin_scene_names();
+
+/// One record of a ray file: 8 little-endian float32, `ox oy oz dx dy dz tmin tmax`.
+/// Reads a whole ray file; throws InputError when its size is not a multiple of 32 bytes, or a
+/// record has a NaN, an infinite origin or direction, a zero direction, or tmin > tmax.
+std::vector<Ray> read_rays(const std::string& path);
+/// Writes rays atomically (to a temporary file renamed into place).
+void write_rays(const std::string& path, std::span<const Ray> rays);
+
+/// Hit file: per ray, int32 primitive id (-1 for a miss) then float32 t.
+/// Writes atomically (to a temporary file renamed into place).
+void write_hits(const std::string& path, std::span<const Hit> hits);
+std::vector<Hit> read_hits(const std::string& path);
+
+/// Writes `bytes` to `path` atomically: a temporary file in the same directory, renamed into
+/// place once complete, so a failure never leaves a half-written output. Throws InputError.
+void write_file_atomic(const std::string& path, std::string_view bytes);
+
+}  // namespace rtcost

@@ -1,0 +1,117 @@
+#pragma once
+/// \file math.hpp
+/// Small vector, box and ray types shared by every part of rtcost.
+///
+/// Written by hand (rather than taken from a linear-algebra library) because the traversal hot
+/// paths need exactly these few float operations inlined, and nothing else.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+
+namespace rtcost {
+
+inline constexpr float kInf = std::numeric_limits<float>::infinity();
+
+/// A 3-component float vector.
+struct Vec3 {
+    float x = 0, y = 0, z = 0;
+
+    constexpr Vec3() = default;
+    constexpr Vec3(float x_, float y_, float z_) : x(x_), y(y_), z(z_) {}
+
+    constexpr float operator[](int i) const { return i == 0 ? x : (i == 1 ? y : z); }
+    constexpr float& operator[](int i) { return i == 0 ? x : (i == 1 ? y : z); }
+
+    constexpr Vec3 operator+(Vec3 o) const { return {x + o.x, y + o.y, z + o.z}; }
+    constexpr Vec3 operator-(Vec3 o) const { return {x - o.x, y - o.y, z - o.z}; }
+    constexpr Vec3 operator-() const { return {-x, -y, -z}; }
+    constexpr Vec3 operator*(float s) const { return {x * s, y * s, z * s}; }
+    constexpr Vec3 operator/(float s) const { return {x / s, y / s, z / s}; }
+    constexpr Vec3 operator*(Vec3 o) const { return {x * o.x, y * o.y, z * o.z}; }
+    constexpr Vec3& operator+=(Vec3 o) { x += o.x; y += o.y; z += o.z; return *this; }
+    constexpr bool operator==(const Vec3&) const = default;
+};
+
+constexpr Vec3 operator*(float s, Vec3 v) { return v * s; }
+constexpr float dot(Vec3 a, Vec3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+constexpr Vec3 cross(Vec3 a, Vec3 b) {
+    return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x};
+}
+inline float length(Vec3 v) { return std::sqrt(dot(v, v)); }
+inline Vec3 normalize(Vec3 v) { return v / length(v); }
+constexpr Vec3 vmin(Vec3 a, Vec3 b) { return {std::min(a.x, b.x), std::min(a.y, b.y), std::min(a.z, b.z)}; }
+constexpr Vec3 vmax(Vec3 a, Vec3 b) { return {std::max(a.x, b.x), std::max(a.y, b.y), std::max(a.z, b.z)}; }
+inline bool is_finite(Vec3 v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); }
+/// Index of the component with the largest magnitude.
+inline int max_axis(Vec3 v) {
+    float ax = std::fabs(v.x), ay = std::fabs(v.y), az = std::fabs(v.z);
+    return ax >= ay ? (ax >= az ? 0 : 2) : (ay >= az ? 1 : 2);
+}
+
+/// Axis-aligned bounding box; the default box is empty (lo = +inf, hi = -inf).
+struct Box3 {
+    Vec3 lo{kInf, kInf, kInf};
+    Vec3 hi{-kInf, -kInf, -kInf};
+
+    constexpr Box3() = default;
+    constexpr Box3(Vec3 l, Vec3 h) : lo(l), hi(h) {}
+
+    constexpr bool empty() const { return lo.x > hi.x || lo.y > hi.y || lo.z > hi.z; }
+    constexpr void extend(Vec3 p) { lo = vmin(lo, p); hi = vmax(hi, p); }
+    constexpr void extend(const Box3& b) { lo = vmin(lo, b.lo); hi = vmax(hi, b.hi); }
+    constexpr Vec3 extent() const { return hi - lo; }
+    constexpr Vec3 center() const { return (lo + hi) * 0.5f; }
+    /// Surface area; 0 for an empty box.
+    constexpr float area() const {
+        if (empty()) return 0;
+        Vec3 e = extent();
+        return 2 * (e.x * e.y + e.y * e.z + e.z * e.x);
+    }
+    constexpr bool contains(Vec3 p) const {
+        return p.x >= lo.x && p.x <= hi.x && p.y >= lo.y && p.y <= hi.y && p.z >= lo.z && p.z <= hi.z;
+    }
+    constexpr bool overlaps(const Box3& b) const {
+        return lo.x <= b.hi.x && b.lo.x <= hi.x && lo.y <= b.hi.y && b.lo.y <= hi.y &&
+               lo.z <= b.hi.z && b.lo.z <= hi.z;
+    }
+};
+
+inline Box3 join(Box3 a, const Box3& b) { a.extend(b); return a; }
+
+/// A ray segment: points o + t d for t in the open interval (tmin, tmax).
+/// The direction need not be normalised; t is measured in units of |d|.
+struct Ray {
+    Vec3 o, d;
+    float tmin = 0, tmax = kInf;
+};
+
+/// Ray with precomputed reciprocal direction for slab tests. Zero direction components give
+/// +-inf reciprocals, which the slab test handles (see box_hit).
+struct RayInv {
+    Vec3 o, d, inv;
+    float tmin, tmax;
+    explicit RayInv(const Ray& r)
+        : o(r.o), d(r.d), inv(1.0f / r.d.x, 1.0f / r.d.y, 1.0f / r.d.z), tmin(r.tmin), tmax(r.tmax) {}
+};
+
+/// Slab test of a ray against a box over (tmin, tmax); returns the entry distance or +inf.
+/// Robust for zero direction components: 0 * inf produces NaN, which std::min/std::max with the
+/// NaN in the second argument discard, so an axis-parallel ray inside the slab is accepted and one
+/// outside (both bounds of the same sign, +-inf) is rejected. The final bounds are multiplied by
+/// 1 + 2 gamma(3) (Ize 2013) so that a ray through an edge or a vertex is never lost to rounding.
+inline float box_entry(const Box3& b, const Vec3& o, const Vec3& inv, float tmin, float tmax) {
+    float t0 = tmin, t1 = tmax;
+    for (int a = 0; a < 3; ++a) {
+        float tn = (b.lo[a] - o[a]) * inv[a];
+        float tf = (b.hi[a] - o[a]) * inv[a];
+        if (tn > tf) std::swap(tn, tf);
+        tf *= 1.0000004f;  // 1 + 2*gamma(3): conservative against rounding
+        t0 = tn > t0 ? tn : t0;
+        t1 = tf < t1 ? tf : t1;
+    }
+    return t0 <= t1 ? t0 : kInf;
+}
+
+}  // namespace rtcost

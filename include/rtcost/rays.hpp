@@ -1,0 +1,31 @@
+#pragma once
+/// \file rays.hpp
+/// Ray distributions: the sets of rays whose cost a hierarchy is measured and predicted on.
+/// Every generator is deterministic for a given seed (same seed, same rays, on every machine).
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "rtcost/scene.hpp"
+
+namespace rtcost {
+
+/// One eye ray per pixel centre of a `width` x `height` image from the scene's camera. The
+/// direction is not normalised: its component along the view axis is 1, so tmin = hither clips
+/// at the hither plane exactly.
+std::vector<Ray> camera_rays(const Camera& cam, int width, int height);
+
+/// `n` isotropic random lines through `box` under the invariant measure of lines (uniform
+/// direction on the sphere, then a uniform point on the box's projection perpendicular to it),
+/// clipped to the box: origin at the entry point, unit direction, (0, chord length).
+std::vector<Ray> line_rays(const Box3& box, std::size_t n, std::uint64_t seed);
+
+/// `n` rays for correctness tests: origins uniform in `box` grown by half its size on each side
+/// (so some start inside and some outside), directions uniform on the sphere, (0, +inf).
+std::vector<Ray> random_rays(const Box3& box, std::size_t n, std::uint64_t seed);
+
+/// Parses "WxH" (e.g. "512x512"); throws InputError naming `what` otherwise.
+void parse_size(const std::string& text, const std::string& what, int& width, int& height);
+
+}  // namespace rtcost

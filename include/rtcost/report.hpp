@@ -1,0 +1,47 @@
+#pragma once
+/// \file report.hpp
+/// Reports: JSON forms of the statistics, human-readable numbers, and terminal progress.
+
+#include <chrono>
+#include <cstdio>
+#include <nlohmann/json.hpp>
+#include <string>
+
+#include "rtcost/scene.hpp"
+#include "rtcost/stats.hpp"
+
+namespace rtcost {
+
+/// `{"N_IN", "N_V", "N_EV", "N_OIV", "depth", "bytes", "seconds"}`.
+nlohmann::json to_json(const StructureStats& s);
+/// Per-ray means: `{"N_IT", "N_TS", "N_ETS", "N_EETS", "box", "plane", "hop", "classify",
+/// "prim", "prim_by_kind": {...}, "visits_by_depth": [...]}` (divided by `c.rays`).
+nlohmann::json per_ray_json(const RayCounters& c);
+/// Scene summary: name, primitive counts by kind, bounds, lights, camera, bytes.
+nlohmann::json to_json(const Scene& s);
+
+/// "1.23 MiB" style.
+std::string human_bytes(std::uint64_t bytes);
+
+/// A one-line progress indicator on stderr. It draws only when stderr is a terminal and it is
+/// not quiet, at most ten times a second, and erases itself when done.
+class Progress {
+public:
+    Progress(std::string label, std::size_t total, bool quiet);
+    ~Progress();
+    Progress(const Progress&) = delete;
+    Progress& operator=(const Progress&) = delete;
+    /// Reports `done` of `total` units finished.
+    void update(std::size_t done);
+    void finish();
+    bool active() const { return active_; }
+
+private:
+    std::string label_;
+    std::size_t total_;
+    bool active_;
+    bool drawn_ = false;
+    std::chrono::steady_clock::time_point start_, last_;
+};
+
+}  // namespace rtcost

@@ -1,0 +1,109 @@
+#pragma once
+/// \file scene.hpp
+/// A scene: primitives of four kinds with materials, positional lights, background and camera.
+///
+/// Primitive ids are 0-based in input order (file order for NFF, mesh then face order for
+/// meshes). Each id maps to a kind and an index into that kind's array; hierarchies store ids.
+
+#include <array>
+#include <cstdint>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "rtcost/primitive.hpp"
+
+namespace rtcost {
+
+/// NFF material (`f r g b Kd Ks Shine T ior`).
+struct Material {
+    Vec3 color{1, 1, 1};
+    float kd = 1, ks = 0, shine = 0, t = 0, ior = 1;
+};
+
+struct Light {
+    Vec3 position;
+    Vec3 color{1, 1, 1};
+};
+
+/// NFF viewpoint (`v`): angle is the full vertical field of view in degrees.
+struct Camera {
+    Vec3 from{0, 0, 1}, at{0, 0, 0}, up{0, 1, 0};
+    float angle = 45;
+    float hither = 0;
+    int width = 512, height = 512;
+};
+
+/// Where a primitive lives: its kind, index into that kind's array and its material.
+struct PrimRef {
+    PrimKind kind;
+    std::uint32_t index;
+    std::uint32_t material;
+};
+
+class Scene {
+public:
+    std::string name;  ///< file path or builtin spec it came from
+
+    // Geometry, by kind. `prims[id]` says which array and index hold primitive `id`.
+    std::vector<PrimRef> prims;
+    std::vector<Triangle> triangles;
+    std::vector<Polygon> polygons;
+    std::vector<Vec3> polygon_vertices;  ///< pool shared by all polygons
+    std::vector<Sphere> spheres;
+    std::vector<Cone> cones;
+
+    std::vector<Material> materials;
+    std::vector<Light> lights;
+    Vec3 background{0, 0, 0};
+    Camera camera;
+    bool has_camera = false;  ///< false: the camera was framed from the bounds
+
+    /// Degenerate or otherwise skipped input, one message per problem ("file:line: problem").
+    std::vector<std::string> warnings;
+
+    std::size_t size() const { return prims.size(); }
+    bool empty() const { return prims.empty(); }
+
+    /// Appenders; each returns the new primitive's id.
+    std::uint32_t add(const Triangle& t, std::uint32_t material);
+    std::uint32_t add(const Sphere& s, std::uint32_t material);
+    std::uint32_t add(const Cone& c, std::uint32_t material);
+    /// Adds a polygon over `verts`; returns false (adding nothing) when it is degenerate.
+    bool add_polygon(std::span<const Vec3> verts, std::uint32_t material, std::uint32_t* id = nullptr);
+
+    Box3 prim_bounds(std::uint32_t id) const;
+    float prim_area(std::uint32_t id) const;
+    PrimKind kind(std::uint32_t id) const { return prims[id].kind; }
+
+    /// Exact intersection of primitive `id`; see primitive.hpp.
+    inline bool intersect(std::uint32_t id, const Ray& ray, float& t) const {
+        const PrimRef& p = prims[id];
+        switch (p.kind) {
+            case PrimKind::Triangle: return rtcost::intersect(triangles[p.index], ray, t);
+            case PrimKind::Polygon: return rtcost::intersect(polygons[p.index], polygon_vertices, ray, t);
+            case PrimKind::Sphere: return rtcost::intersect(spheres[p.index], ray, t);
+            case PrimKind::Cone: return rtcost::intersect(cones[p.index], ray, t);
+        }
+        return false;
+    }
+
+    /// Fills `hit.ng` (unit geometric normal) for a hit found by any hierarchy.
+    void complete_hit(const Ray& ray, Hit& hit) const;
+
+    /// Bounds of all primitives (cached after finalize()).
+    const Box3& bounds() const { return bounds_; }
+    /// Counts of primitives by kind, indexed by PrimKind.
+    std::array<std::size_t, kPrimKinds> kind_counts() const;
+    /// Bytes of geometry held (primitive arrays and pools).
+    std::size_t bytes() const;
+
+    /// Computes bounds and, when the input had no camera, a default one framing the bounds; adds
+    /// a default light when there is none and a default material when there is none.
+    void finalize();
+
+private:
+    Box3 bounds_;
+};
+
+}  // namespace rtcost

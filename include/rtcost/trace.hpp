@@ -1,0 +1,35 @@
+#pragma once
+/// \file trace.hpp
+/// Tracing a batch of rays through a hierarchy on many threads (TBB), with or without counting.
+
+#include <functional>
+#include <span>
+#include <vector>
+
+#include "rtcost/hierarchy.hpp"
+
+namespace rtcost {
+
+struct TraceOptions {
+    Query query = Query::Closest;
+    int threads = 0;         ///< 0: all cores
+    bool count = false;      ///< run the counting instantiation of the traversal
+    /// Called now and then with the number of rays done so far (from any thread, serialised).
+    std::function<void(std::size_t)> progress;
+};
+
+struct TraceResult {
+    std::vector<Hit> hits;    ///< one per ray; for Query::Any, the first hit found
+    std::size_t hit_count = 0;
+    double seconds = 0;       ///< traversal alone
+    int threads = 1;
+    RayCounters counters;     ///< summed over all rays (when counting)
+};
+
+/// Traces every ray. Hits carry `t` and `prim`; call Scene::complete_hit for normals.
+TraceResult trace_rays(const Hierarchy& h, std::span<const Ray> rays, const TraceOptions& opt = {});
+
+/// Number of hardware threads TBB will use by default.
+int default_threads();
+
+}  // namespace rtcost

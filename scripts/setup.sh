@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# One command from a fresh Debian machine to a result: installs the dependencies, builds rtcost
+# and runs the main job on a built-in scene (no files needed).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/install-deps.sh
+bash scripts/build.sh
+./build/rtcost info builtin:balls
+./build/rtcost trace builtin:tetra --hierarchy brute --rays camera --size 128x128

@@ -1,0 +1,42 @@
+// `brute`: tests every primitive for every ray. The reference every other hierarchy is checked
+// against; it has no structure, so its structural statistics describe one leaf holding all.
+#include "rtcost/hierarchy.hpp"
+
+namespace rtcost {
+namespace {
+
+class Brute final : public HierarchyImpl<Brute> {
+public:
+    explicit Brute(const Scene& s) : HierarchyImpl(s) {}
+    std::string_view name() const override { return "brute"; }
+
+    template <class C, Query Q>
+    bool trace(const Ray& ray, Hit& hit, C& counting) const {
+        const auto n = static_cast<std::uint32_t>(scene_->size());
+        counting.leaf(0, n);
+        bool found = false;
+        for (std::uint32_t id = 0; id < n; ++id) {
+            if (test_prim(*scene_, id, ray, hit, counting)) {
+                found = true;
+                if constexpr (Q == Query::Any) return true;
+            }
+        }
+        return found;
+    }
+
+protected:
+    StructureStats compute_structure() const override {
+        StructureStats s;
+        s.leaves = 1;
+        s.empty_leaves = scene_->empty() ? 1 : 0;
+        s.references = scene_->size();
+        s.bytes = 0;
+        return s;
+    }
+};
+
+const Registration reg{{"brute", "every primitive tested for every ray (the reference)", {},
+                        [](const Scene& s, const Params&) { return std::make_unique<Brute>(s); }}};
+
+}  // namespace
+}  // namespace rtcost

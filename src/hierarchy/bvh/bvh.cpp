@@ -1,0 +1,110 @@
+// BVH family: structure statistics, the model-tree walk and the registrations of the three
+// builders.
+#include "bvh.hpp"
+
+namespace rtcost::bvh {
+
+PrimInfo::PrimInfo(const Scene& s) : bounds(s.size()), centroids(s.size()) {
+    for (std::uint32_t i = 0; i < s.size(); ++i) {
+        bounds[i] = s.prim_bounds(i);
+        centroids[i] = bounds[i].center();
+    }
+}
+
+StructureStats Bvh::compute_structure() const {
+    StructureStats s;
+    // Depth by a walk from the root; children are always stored after their parent.
+    std::vector<int> depth(d_.nodes.size(), 0);
+    for (std::size_t i = 0; i < d_.nodes.size(); ++i) {
+        const Node& n = d_.nodes[i];
+        if (n.leaf) {
+            ++s.leaves;
+            s.empty_leaves += n.count == 0;
+            s.references += n.count;
+            s.depth = std::max(s.depth, depth[i]);
+        } else {
+            ++s.interior;
+            for (std::uint32_t k = 0; k < n.count; ++k) depth[n.index + k] = depth[i] + 1;
+        }
+    }
+    s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t);
+    return s;
+}
+
+ModelTree Bvh::model_tree() const {
+    ModelTree t;
+    t.nodes.resize(d_.nodes.size());
+    t.prims = d_.refs;
+    for (std::size_t i = 0; i < d_.nodes.size(); ++i) {
+        const Node& n = d_.nodes[i];
+        ModelNode& m = t.nodes[i];
+        m.region = n.box;
+        m.has_bv = true;
+        m.first = n.index;
+        m.count = n.count;
+        m.leaf = n.leaf;
+        if (!n.leaf)
+            for (std::uint32_t k = 0; k < n.count; ++k) t.nodes[n.index + k].depth = m.depth + 1;
+    }
+    return t;
+}
+
+namespace {
+
+bool ordered(const Params& p) { return p.choice("order", {"near", "none"}) == "near"; }
+
+const ParamSpec kOrder{"order", "near",
+                       "near: near child first, far child skipped beyond the current hit; none: every child "
+                       "met is visited (the paper's BVH case)"};
+
+const Registration median_reg{
+    {"bvh-median",
+     "Kay and Kajiya's BVH: object median cut on the longest axis",
+     {{"max_prims", "1", "largest leaf"}, {"max_depth", "64", "deepest leaf (root at 0)"}, kOrder},
+     [](const Scene& s, const Params& p) {
+         MedianOptions o;
+         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
+         o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
+         return std::make_unique<Bvh>(s, "bvh-median", build_median(s, o), ordered(p));
+     }}};
+
+const Registration gs_reg{
+    {"bvh-gs",
+     "Goldsmith and Salmon's BVH: incremental insertion minimising surface-area cost",
+     {{"max_prims", "1", "largest leaf (1: one object per leaf, as in the original)"},
+      {"max_depth", "64", "deepest node"},
+      {"max_children", "8", "largest fan-out of a node (2..8)"},
+      {"seed", "0", "insertion order: 0 = file order, otherwise shuffled with this seed"},
+      kOrder},
+     [](const Scene& s, const Params& p) {
+         GsOptions o;
+         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
+         o.max_depth = static_cast<int>(p.integer("max_depth", 1, kMaxDepth));
+         o.max_children = static_cast<int>(p.integer("max_children", 2, kMaxFanout));
+         o.seed = static_cast<std::uint64_t>(p.integer("seed", 0, 1LL << 62));
+         return std::make_unique<Bvh>(s, "bvh-gs", build_gs(s, o), ordered(p));
+     }}};
+
+const Registration sah_reg{
+    {"bvh-sah",
+     "binned SAH BVH (Wald 2007); sweep=1 for the full sweep",
+     {{"max_prims", "8", "largest leaf (bigger nodes are always split)"},
+      {"max_depth", "64", "deepest leaf"},
+      {"bins", "16", "bins per axis for the binned build"},
+      {"sweep", "0", "1: evaluate every split of the sorted centroids (full sweep SAH)"},
+      {"c_trav", "1", "SAH cost of a traversal step"},
+      {"c_isect", "1", "SAH cost of a primitive test"},
+      kOrder},
+     [](const Scene& s, const Params& p) {
+         SahOptions o;
+         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
+         o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
+         o.bins = static_cast<int>(p.integer("bins", 2, 256));
+         o.sweep = p.flag("sweep");
+         o.c_trav = static_cast<float>(p.real("c_trav", 0, 1e6));
+         o.c_isect = static_cast<float>(p.real("c_isect", 1e-6, 1e6));
+         return std::make_unique<Bvh>(s, "bvh-sah", build_sah(s, o), ordered(p));
+     }}};
+
+}  // namespace
+}  // namespace rtcost::bvh

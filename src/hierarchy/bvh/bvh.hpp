@@ -1,0 +1,139 @@
+#pragma once
+// The bounding volume hierarchy shared by the BVH builders (bvh-median, bvh-gs, bvh-sah): one
+// node layout, one traversal template, one model-tree walk. Builders differ only in how they
+// fill `BvhData`.
+
+#include <algorithm>
+#include <vector>
+
+#include "rtcost/hierarchy.hpp"
+
+namespace rtcost::bvh {
+
+/// 32 bytes. Children of an interior node are contiguous from `index`; a leaf's primitive
+/// references are contiguous in BvhData::refs from `index`.
+struct Node {
+    Box3 box;
+    std::uint32_t index = 0;
+    std::uint32_t count : 31 = 0;
+    std::uint32_t leaf : 1 = 1;
+};
+static_assert(sizeof(Node) == 32);
+
+/// Bound on any node's fan-out and on depth; together they bound the traversal stack.
+inline constexpr int kMaxFanout = 8;
+inline constexpr int kMaxDepth = 100;
+
+struct BvhData {
+    std::vector<Node> nodes;           ///< nodes[0] is the root
+    std::vector<std::uint32_t> refs;   ///< primitive ids in leaf order
+};
+
+/// Per-primitive bounds and centroids, computed once per build.
+struct PrimInfo {
+    std::vector<Box3> bounds;
+    std::vector<Vec3> centroids;
+    explicit PrimInfo(const Scene& s);
+};
+
+// The builders (one file each).
+struct MedianOptions { int max_prims = 1; int max_depth = 64; };
+BvhData build_median(const Scene& s, const MedianOptions& o);
+
+struct GsOptions { int max_prims = 1; int max_depth = 64; int max_children = kMaxFanout; std::uint64_t seed = 0; };
+BvhData build_gs(const Scene& s, const GsOptions& o);
+
+struct SahOptions {
+    int max_prims = 8;     ///< larger nodes are always split
+    int max_depth = 64;
+    int bins = 16;         ///< binned SAH bins per axis
+    bool sweep = false;    ///< full sweep over sorted centroids instead of bins
+    float c_trav = 1;      ///< cost of a traversal step, relative to...
+    float c_isect = 1;     ///< ...one primitive test
+};
+BvhData build_sah(const Scene& s, const SahOptions& o);
+
+/// The BVH hierarchy over built data. `ordered`: near child first and children whose entry lies
+/// beyond the current hit skipped; otherwise every child whose box the ray meets is visited, in
+/// stored order, and no subtree is cut by a hit found (the paper's BVH case).
+class Bvh final : public HierarchyImpl<Bvh> {
+public:
+    Bvh(const Scene& s, std::string name, BvhData data, bool ordered)
+        : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered) {}
+
+    std::string_view name() const override { return name_; }
+    ModelTree model_tree() const override;
+
+    template <class C, Query Q>
+    bool trace(const Ray& ray, Hit& hit, C& counting) const {
+        return ordered_ ? walk<C, Q, true>(ray, hit, counting) : walk<C, Q, false>(ray, hit, counting);
+    }
+
+protected:
+    StructureStats compute_structure() const override;
+
+private:
+    template <class C, Query Q, bool kOrdered>
+    bool walk(const Ray& ray, Hit& hit, C& counting) const {
+        struct Entry {
+            std::uint32_t node;
+            float t;
+            int depth;
+        };
+        // Stack bound: along any path at most kMaxFanout - 1 siblings wait per level.
+        Entry stack[kMaxDepth * (kMaxFanout - 1) + 2];
+        int sp = 0;
+        const Node* nodes = d_.nodes.data();
+        const RayInv ri(ray);
+        counting.box();
+        float t0 = box_entry(nodes[0].box, ri.o, ri.inv, ray.tmin, ray.tmax);
+        if (t0 == kInf) return false;
+        stack[sp++] = {0, t0, 0};
+        bool found = false;
+        while (sp > 0) {
+            const Entry e = stack[--sp];
+            if constexpr (kOrdered) {
+                if (e.t >= hit.t) continue;  // the whole box lies beyond the current hit
+            }
+            const Node& n = nodes[e.node];
+            if (n.leaf) {
+                counting.leaf(e.depth, n.count);
+                for (std::uint32_t k = 0; k < n.count; ++k) {
+                    if (test_prim(*scene_, d_.refs[n.index + k], ray, hit, counting)) {
+                        found = true;
+                        if constexpr (Q == Query::Any) return true;
+                    }
+                }
+                continue;
+            }
+            counting.interior(e.depth);
+            const float limit = kOrdered ? std::min(hit.t, ray.tmax) : ray.tmax;
+            Entry hits[kMaxFanout];
+            int nh = 0;
+            for (std::uint32_t k = 0; k < n.count; ++k) {
+                counting.box();
+                float t = box_entry(nodes[n.index + k].box, ri.o, ri.inv, ray.tmin, limit);
+                if (t != kInf) hits[nh++] = {n.index + k, t, e.depth + 1};
+            }
+            if constexpr (kOrdered) {
+                // Nearest last, so it is popped first. Fan-out is small: insertion sort.
+                for (int i = 1; i < nh; ++i) {
+                    Entry x = hits[i];
+                    int j = i - 1;
+                    for (; j >= 0 && hits[j].t < x.t; --j) hits[j + 1] = hits[j];
+                    hits[j + 1] = x;
+                }
+                for (int i = 0; i < nh; ++i) stack[sp++] = hits[i];
+            } else {
+                for (int i = nh - 1; i >= 0; --i) stack[sp++] = hits[i];
+            }
+        }
+        return found;
+    }
+
+    std::string name_;
+    BvhData d_;
+    bool ordered_;
+};
+
+}  // namespace rtcost::bvh

@@ -1,0 +1,220 @@
+// The command line as a user meets it: exit codes, messages that name the file and problem, JSON
+// fields with real values, and no output file left behind on failure.
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <sys/wait.h>
+
+#include "rtcost/io.hpp"
+#include "rtcost/rays.hpp"
+
+namespace fs = std::filesystem;
+
+namespace {
+
+struct Run {
+    int code;
+    std::string out, err;
+};
+
+fs::path temp_dir() {
+    fs::path d = fs::temp_directory_path() / ("rtcost_cli_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+}
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+Run run(const std::string& args) {
+    fs::path d = temp_dir();
+    std::string cmd = std::string(RTCOST_CLI) + " " + args + " > " + (d / "out").string() + " 2> " + (d / "err").string() +
+                      " < /dev/null";
+    int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(d / "out"), slurp(d / "err")};
+}
+
+fs::path write(const std::string& name, const std::string& bytes) {
+    fs::path p = temp_dir() / name;
+    std::ofstream(p, std::ios::binary) << bytes;
+    return p;
+}
+
+const char* kSmallNff =
+    "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.1\nresolution 8 8\n"
+    "l 0 5 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\np 3\n-3 -3 -2\n3 -3 -2\n0 3 -2\n";
+
+TEST(Cli, HelpListsSubcommandsAndHierarchyParameters) {
+    Run r = run("--help");
+    EXPECT_EQ(r.code, 0);
+    for (const char* s : {"info", "build", "trace", "list"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
+    Run t = run("trace --help");
+    EXPECT_EQ(t.code, 0);
+    EXPECT_NE(t.out.find("bvh-sah"), std::string::npos);
+    EXPECT_NE(t.out.find("max_prims=8"), std::string::npos);  // defaults are printed
+    EXPECT_NE(t.out.find("--threads"), std::string::npos);
+}
+
+TEST(Cli, InfoJsonReportsCountsBoundsLightsCamera) {
+    Run r = run("info builtin:balls --json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["primitives"], 7382);
+    EXPECT_EQ(j["by_kind"]["sphere"], 7381);
+    EXPECT_EQ(j["by_kind"]["polygon"], 1);
+    EXPECT_EQ(j["lights"].size(), 3u);
+    EXPECT_EQ(j["camera"]["resolution"][0], 512);
+    EXPECT_GT(j["bytes"].get<double>(), 7381 * 16.0);
+}
+
+TEST(Cli, TraceJsonHasTimingsAndPerRayCounters) {
+    fs::path scene = write("small.nff", kSmallNff);
+    Run r = run("trace " + scene.string() + " --hierarchy bvh-sah --rays camera --json --threads 1");
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["hierarchy"], "bvh-sah");
+    EXPECT_EQ(j["trace"]["rays"], 64);
+    EXPECT_EQ(j["trace"]["threads"], 1);
+    // The sphere fills the middle of the 8x8 view and the triangle is behind: most rays hit.
+    EXPECT_GT(j["trace"]["hits"].get<int>(), 20);
+    EXPECT_GE(j["trace"]["seconds"].get<double>(), 0.0);
+    EXPECT_GT(j["trace"]["mrays_per_s"].get<double>(), 0.0);
+    EXPECT_EQ(j["build"]["N_OIV"], 2);
+    EXPECT_EQ(j["build"]["N_V"].get<int>(), j["build"]["N_IN"].get<int>() + 1);
+    EXPECT_GE(j["trace"]["per_ray"]["box"].get<double>(), 1.0);
+    EXPECT_GT(j["trace"]["per_ray"]["N_IT"].get<double>(), 0.0);
+    for (const char* k : {"N_IT", "N_TS", "N_ETS", "N_EETS", "box", "plane", "hop", "classify", "prim"})
+        EXPECT_TRUE(j["trace"]["per_ray"].contains(k)) << k;
+    EXPECT_TRUE(j["build"].contains("seconds"));
+}
+
+TEST(Cli, TraceWritesHitsMatchingBruteForce) {
+    fs::path scene = write("small2.nff", kSmallNff);
+    std::vector<rtcost::Ray> rays = {
+        {{0, 0, 5}, {0, 0, -1}, 0, rtcost::kInf},    // sphere at t = 4
+        {{0.5f, -2.5f, 5}, {0, 0, -1}, 0, rtcost::kInf}, // misses the sphere, hits the triangle at t = 7
+        {{9, 9, 5}, {0, 0, -1}, 0, rtcost::kInf},    // misses everything
+        {{0, 0, 5}, {0, 0, -1}, 0, 3.0f},            // segment ends before the sphere
+    };
+    fs::path rf = temp_dir() / "four.rays";
+    rtcost::write_rays(rf.string(), rays);
+    fs::path hf = temp_dir() / "four.hits";
+    Run r = run("trace " + scene.string() + " -H brute --rays " + rf.string() + " --hits " + hf.string() + " -q");
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto hits = rtcost::read_hits(hf.string());
+    ASSERT_EQ(hits.size(), 4u);
+    EXPECT_EQ(hits[0].prim, 0);
+    EXPECT_FLOAT_EQ(hits[0].t, 4.0f);
+    EXPECT_EQ(hits[1].prim, 1);
+    EXPECT_FLOAT_EQ(hits[1].t, 7.0f);
+    EXPECT_EQ(hits[2].prim, -1);
+    EXPECT_EQ(hits[3].prim, -1);
+    // Same file through a BVH: byte-identical hits.
+    fs::path hf2 = temp_dir() / "four_bvh.hits";
+    ASSERT_EQ(run("trace " + scene.string() + " -H bvh-median --rays " + rf.string() + " --hits " + hf2.string()).code, 0);
+    EXPECT_EQ(slurp(hf), slurp(hf2));
+}
+
+TEST(Cli, RayFileOfWrongSizeIsRejectedAndNoHitsFileWritten) {
+    fs::path rf = write("bad.rays", std::string(33, '\0'));
+    fs::path hf = temp_dir() / "never.hits";
+    fs::remove(hf);
+    Run r = run("trace builtin:tetra:2 --rays " + rf.string() + " --hits " + hf.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find(rf.string()), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("not a multiple of 32"), std::string::npos) << r.err;
+    EXPECT_FALSE(fs::exists(hf));
+}
+
+TEST(Cli, RayFileWithNaNNamesTheRay) {
+    std::vector<rtcost::Ray> rays(3, rtcost::Ray{{0, 0, 5}, {0, 0, -1}, 0, rtcost::kInf});
+    rays[2].o.y = std::nanf("");
+    fs::path rf = temp_dir() / "nan.rays";
+    rtcost::write_rays(rf.string(), rays);
+    Run r = run("trace builtin:tetra:2 --rays " + rf.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("ray 2"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("not finite"), std::string::npos) << r.err;
+}
+
+TEST(Cli, MissingSceneFileIsAClearError) {
+    Run r = run("info /no/such/scene.nff");
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("/no/such/scene.nff"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find("no such file"), std::string::npos) << r.err;
+}
+
+TEST(Cli, MalformedNffNamesFileAndLine) {
+    fs::path scene = write("broken.nff", "s 0 0 0 1\ns 1 2 nan 1\n");
+    Run r = run("info " + scene.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find(scene.string() + ":2:"), std::string::npos) << r.err;
+    fs::path trunc = write("trunc.nff", "p 4\n0 0 0\n1 0 0\n");
+    Run t = run("info " + trunc.string());
+    EXPECT_EQ(t.code, 2);
+    EXPECT_NE(t.err.find(trunc.string()), std::string::npos) << t.err;
+}
+
+TEST(Cli, EmptySceneIsAClearError) {
+    fs::path scene = write("empty.nff", "# nothing here\nb 0 0 0\n");
+    Run r = run("info " + scene.string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_NE(r.err.find("no primitives"), std::string::npos) << r.err;
+}
+
+TEST(Cli, UnknownOptionsHierarchiesAndParametersExitTwo) {
+    Run a = run("trace builtin:tetra:2 --frobnicate");
+    EXPECT_EQ(a.code, 2);
+    EXPECT_NE(a.err.find("frobnicate"), std::string::npos) << a.err;
+    Run b = run("trace builtin:tetra:2 --hierarchy nope");
+    EXPECT_EQ(b.code, 2);
+    EXPECT_NE(b.err.find("unknown hierarchy 'nope'"), std::string::npos) << b.err;
+    Run c = run("build builtin:tetra:2 --hierarchy bvh-sah --set max_prims=-4");
+    EXPECT_EQ(c.code, 2);
+    EXPECT_NE(c.err.find("max_prims"), std::string::npos) << c.err;
+    Run d = run("frobnicate");
+    EXPECT_EQ(d.code, 2);
+    Run e = run("info builtin:nosuchscene");
+    EXPECT_EQ(e.code, 2);
+    EXPECT_NE(e.err.find("nosuchscene"), std::string::npos) << e.err;
+}
+
+TEST(Cli, DegeneratePrimitivesAreReportedAndSkipped) {
+    fs::path scene = write("degen.nff", "s 0 0 0 0\ns 0 0 0 1\np 3\n0 0 0\n1 1 1\n2 2 2\n");
+    Run r = run("info " + scene.string() + " --json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["primitives"], 1);
+    EXPECT_EQ(j["warnings"], 2);
+    Run t = run("info " + scene.string());
+    EXPECT_NE(t.err.find(scene.string() + ":1:"), std::string::npos) << t.err;
+}
+
+TEST(Cli, BuildPrintsStructure) {
+    Run r = run("build builtin:tetra:3 -H bvh-median --set max_prims=1 --json");
+    ASSERT_EQ(r.code, 0) << r.err;
+    auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["build"]["N_V"], 64);
+    EXPECT_EQ(j["build"]["N_IN"], 63);
+    EXPECT_EQ(j["build"]["N_OIV"], 64);
+    EXPECT_EQ(j["build"]["depth"], 6);
+    EXPECT_EQ(j["params"]["max_prims"], "1");
+}
+
+TEST(Cli, QuietAndPipedOutputHasNoProgressNoise) {
+    Run r = run("trace builtin:tetra:3 -H bvh-sah --rays camera --size 32x32");
+    ASSERT_EQ(r.code, 0) << r.err;
+    EXPECT_EQ(r.err, "");  // stderr is not a terminal here: no progress drawn
+    EXPECT_NE(r.out.find("1024"), std::string::npos);
+}
+
+}  // namespace

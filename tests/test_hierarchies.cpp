@@ -1,0 +1,272 @@
+// Every hierarchy against brute force (exactly the same t) and brute force against Embree, on
+// real scenes and hard rays; plus the structural and counting invariants of the shared interface.
+#include <map>
+
+#include "test_support.hpp"
+
+namespace rtcost::test {
+namespace {
+
+// The hierarchies checked here, with the parameter variants that change traversal or build.
+const std::vector<std::pair<std::string, std::vector<std::string>>> kVariants = {
+    {"bvh-median", {}},
+    {"bvh-median", {"order=none"}},
+    {"bvh-gs", {}},
+    {"bvh-gs", {"seed=7", "max_prims=3"}},
+    {"bvh-sah", {}},
+    {"bvh-sah", {"sweep=1", "order=none"}},
+};
+
+struct Reference {
+    Scene scene;
+    std::vector<Ray> rays;
+    std::vector<Hit> brute;
+};
+
+// Brute force is the slow part; each scene's reference is computed once for all tests.
+const Reference& reference(const std::string& spec) {
+    static std::map<std::string, Reference> cache;
+    auto it = cache.find(spec);
+    if (it != cache.end()) return it->second;
+    Reference r{load_scene(spec), {}, {}};
+    r.rays = hard_rays(r.scene, 100000, 42);
+    auto brute = build_hierarchy(r.scene, "brute");
+    r.brute = closest_hits(*brute, r.rays);
+    return cache.emplace(spec, std::move(r)).first->second;
+}
+
+std::string scene_spec(const std::string& name) {
+    return name.rfind("builtin:", 0) == 0 || name.find('/') != std::string::npos ? name : spd_path(name);
+}
+
+class SceneCheck : public ::testing::TestWithParam<std::string> {
+protected:
+    void SetUp() override {
+        std::string spec = scene_spec(GetParam());
+        if (!std::filesystem::exists(spec) && spec.rfind("builtin:", 0) != 0)
+            GTEST_SKIP() << spec << " not present";
+    }
+    const Reference& ref() { return reference(scene_spec(GetParam())); }
+};
+
+TEST_P(SceneCheck, BruteForceHitsSomething) {
+    const Reference& r = ref();
+    std::size_t hits = 0;
+    for (const Hit& h : r.brute) hits += h.hit();
+    // Every scene is hit by a real share of the test rays, and missed by some.
+    EXPECT_GT(hits, r.rays.size() / 50);
+    EXPECT_LT(hits, r.rays.size());
+}
+
+TEST_P(SceneCheck, EmbreeAgreesWithBruteForce) {
+    const Reference& r = ref();
+    auto embree = build_hierarchy(r.scene, "embree");
+    // Random rays only: the vertex- and edge-aimed rays are where a non-watertight peer may
+    // legitimately differ.
+    std::size_t n = 100000;
+    std::vector<Hit> got = closest_hits(*embree, std::span(r.rays).first(n));
+    std::string first;
+    std::size_t bad = count_mismatches(std::span(r.brute).first(n), got, 1e-4f, &first);
+    EXPECT_EQ(bad, 0u) << first;
+}
+
+TEST_P(SceneCheck, EveryHierarchyMatchesBruteForceExactly) {
+    const Reference& r = ref();
+    for (const auto& [name, set] : kVariants) {
+        auto h = build_hierarchy(r.scene, name, set);
+        std::vector<Hit> got = closest_hits(*h, r.rays);
+        std::string first;
+        EXPECT_EQ(count_mismatches(r.brute, got, 0.0f, &first), 0u)
+            << name << " " << ::testing::PrintToString(set) << ": " << first;
+    }
+}
+
+TEST_P(SceneCheck, AnyHitAgreesWithClosestHit) {
+    const Reference& r = ref();
+    for (const auto& [name, set] : kVariants) {
+        auto h = build_hierarchy(r.scene, name, set);
+        TraceOptions opt;
+        opt.query = Query::Any;
+        TraceResult any = trace_rays(*h, r.rays, opt);
+        std::size_t bad = 0;
+        for (std::size_t i = 0; i < r.rays.size(); ++i) {
+            bad += any.hits[i].hit() != r.brute[i].hit();
+            // The hit reported by an any-hit query is a real hit within the segment.
+            if (any.hits[i].hit()) {
+                float t;
+                Ray ray = r.rays[i];
+                bad += !r.scene.intersect(static_cast<std::uint32_t>(any.hits[i].prim), ray, t);
+            }
+        }
+        EXPECT_EQ(bad, 0u) << name;
+    }
+}
+
+TEST_P(SceneCheck, CountingDoesNotChangeHitsAndInvariantsHold) {
+    const Reference& r = ref();
+    std::span<const Ray> rays = std::span(r.rays).first(20000);
+    for (const auto& [name, set] : kVariants) {
+        auto h = build_hierarchy(r.scene, name, set);
+        StructureStats s = h->structure();
+        // Binary trees: N_V = N_IN + 1; n-ary ones (Goldsmith-Salmon): more leaves than that.
+        if (name == "bvh-gs") EXPECT_GE(s.leaves, s.interior + 1) << name;
+        else EXPECT_EQ(s.leaves, s.interior + 1) << name;
+        EXPECT_EQ(s.references, r.scene.size()) << name;  // BVH: every primitive in exactly one leaf
+        EXPECT_GT(s.bytes, 0u);
+        TraceOptions opt;
+        TraceResult fast = trace_rays(*h, rays, opt);
+        opt.count = true;
+        TraceResult counted = trace_rays(*h, rays, opt);
+        std::string first;
+        EXPECT_EQ(count_mismatches(fast.hits, counted.hits, 0.0f, &first), 0u) << name << ": " << first;
+        for (std::size_t i = 0; i < rays.size(); ++i) EXPECT_EQ(fast.hits[i].prim, counted.hits[i].prim);
+        const RayCounters& c = counted.counters;
+        EXPECT_EQ(c.rays, rays.size());
+        EXPECT_GT(c.box, c.rays);  // at least the root box per ray, and more for rays that enter
+        EXPECT_EQ(c.plane + c.hop + c.classify, 0u);
+        EXPECT_LT(c.leaves, c.steps);  // a leaf is reached through interior nodes
+        std::uint64_t visits = 0;
+        for (auto v : c.visits) visits += v;
+        EXPECT_EQ(visits, c.steps) << name;
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Spd, SceneCheck,
+                         ::testing::Values("balls", "gears", "mount", "rings", "teapot", "tetra", "tree", "lattice",
+                                           "shells", "sombrero"));
+INSTANTIATE_TEST_SUITE_P(Builtin, SceneCheck, ::testing::Values("builtin:balls:2", "builtin:tetra:4"));
+INSTANTIATE_TEST_SUITE_P(Mesh, SceneCheck,
+                         ::testing::Values("/usr/share/assimp/models/OBJ/spider.obj",
+                                           "/usr/share/assimp/models/PLY/Wuson.ply"),
+                         [](const auto& info) { return std::filesystem::path(info.param).stem().string(); });
+
+// Binary BVHs: N_V = N_IN + 1 exactly.
+TEST(BvhStructure, BinaryTreesHaveOneMoreLeafThanInteriorNodes) {
+    Scene s = builtin_scene("tetra", 4);
+    for (const char* name : {"bvh-median", "bvh-sah"}) {
+        auto h = build_hierarchy(s, name);
+        StructureStats st = h->structure();
+        EXPECT_EQ(st.leaves, st.interior + 1) << name;
+        EXPECT_EQ(st.references, s.size()) << name;
+    }
+    // Kay-Kajiya with one object per leaf: exactly one leaf per primitive.
+    auto m = build_hierarchy(s, "bvh-median", {"max_prims=1"});
+    EXPECT_EQ(m->structure().leaves, s.size());
+    EXPECT_EQ(m->structure().interior, s.size() - 1);
+    // Median cut halves the list: depth is ceil(log2 N).
+    EXPECT_EQ(m->structure().depth, 8);  // 256 triangles
+}
+
+TEST(BvhStructure, MaxDepthZeroIsOneLeaf) {
+    Scene s = builtin_scene("tetra", 3);
+    for (const char* name : {"bvh-median", "bvh-sah"}) {
+        auto h = build_hierarchy(s, name, {"max_depth=0"});
+        StructureStats st = h->structure();
+        EXPECT_EQ(st.interior, 0u) << name;
+        EXPECT_EQ(st.leaves, 1u) << name;
+        EXPECT_EQ(st.references, s.size()) << name;
+    }
+}
+
+TEST(BvhStructure, GoldsmithSalmonRespectsFanoutAndLeafSize) {
+    Scene s = builtin_scene("balls", 2);
+    auto h = build_hierarchy(s, "bvh-gs", {"max_children=3", "max_prims=2"});
+    ModelTree t = h->model_tree();
+    ASSERT_FALSE(t.nodes.empty());
+    std::size_t refs = 0;
+    for (const ModelNode& n : t.nodes) {
+        if (n.leaf) {
+            EXPECT_LE(n.count, 2u);
+            refs += n.count;
+        } else {
+            EXPECT_GE(n.count, 2u);
+            EXPECT_LE(n.count, 3u);
+        }
+    }
+    EXPECT_EQ(refs, s.size());
+    // Every child lies inside its parent's box.
+    for (const ModelNode& n : t.nodes) {
+        if (n.leaf) continue;
+        for (std::uint32_t k = 0; k < n.count; ++k) {
+            const Box3& c = t.nodes[n.first + k].region;
+            EXPECT_TRUE(n.region.contains(c.lo) && n.region.contains(c.hi));
+        }
+    }
+}
+
+TEST(BvhStructure, InsertionOrderChangesTheTreeButNotTheHits) {
+    Scene s = builtin_scene("balls", 2);
+    auto a = build_hierarchy(s, "bvh-gs");
+    auto b = build_hierarchy(s, "bvh-gs", {"seed=3"});
+    EXPECT_NE(a->structure().depth * 1000 + a->structure().interior, b->structure().depth * 1000 + b->structure().interior);
+    auto rays = random_rays(s.bounds(), 5000, 9);
+    EXPECT_EQ(count_mismatches(closest_hits(*a, rays), closest_hits(*b, rays), 0.0f), 0u);
+}
+
+TEST(BvhCounting, RayMissingTheRootBoxCostsOneBoxTest) {
+    Scene s = builtin_scene("tetra", 3);
+    Ray miss{{100, 100, 100}, {1, 0, 0}, 0, kInf};
+    for (const char* name : {"bvh-median", "bvh-gs", "bvh-sah"}) {
+        auto h = build_hierarchy(s, name);
+        RayCounters c;
+        Hit hit;
+        h->closest(miss, hit, c);
+        EXPECT_FALSE(hit.hit());
+        EXPECT_EQ(c.box, 1u) << name;
+        EXPECT_EQ(c.steps, 0u) << name;
+        EXPECT_EQ(c.prim_tests(), 0u) << name;
+    }
+}
+
+TEST(BvhCounting, UnorderedVisitsEverythingTheRayMeets) {
+    // order=none visits at least as many nodes as ordered traversal, for every ray, and the same
+    // hits; on a ray through the whole scene it tests strictly more.
+    Scene s = builtin_scene("tetra", 4);
+    auto near = build_hierarchy(s, "bvh-sah");
+    auto none = build_hierarchy(s, "bvh-sah", {"order=none"});
+    auto rays = random_rays(s.bounds(), 2000, 5);
+    std::uint64_t more = 0;
+    for (const Ray& r : rays) {
+        RayCounters a, b;
+        Hit ha, hb;
+        near->closest(r, ha, a);
+        none->closest(r, hb, b);
+        EXPECT_EQ(ha.t, hb.t);
+        EXPECT_LE(a.steps, b.steps);
+        EXPECT_LE(a.prim_tests(), b.prim_tests());
+        more += b.steps > a.steps;
+    }
+    EXPECT_GT(more, 100u);
+}
+
+TEST(BruteCounting, TestsEveryPrimitiveOnce) {
+    Scene s = builtin_scene("balls", 1);  // 10 spheres + 1 polygon
+    auto h = build_hierarchy(s, "brute");
+    RayCounters c;
+    Hit hit;
+    h->closest(Ray{{0, 0, 5}, {0, 0, -1}, 0, kInf}, hit, c);
+    EXPECT_EQ(c.prim[static_cast<int>(PrimKind::Sphere)], 10u);
+    EXPECT_EQ(c.prim[static_cast<int>(PrimKind::Polygon)], 1u);
+    EXPECT_EQ(c.leaves, 1u);
+    EXPECT_TRUE(hit.hit());
+}
+
+TEST(Registry, UnknownHierarchyAndParametersAreClearErrors) {
+    Scene s = builtin_scene("tetra", 2);
+    try {
+        build_hierarchy(s, "no-such-tree");
+        FAIL();
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("unknown hierarchy 'no-such-tree'"), std::string::npos);
+        EXPECT_NE(std::string(e.what()).find("bvh-sah"), std::string::npos);
+    }
+    EXPECT_THROW(build_hierarchy(s, "bvh-sah", {"max_leaf=3"}), InputError);
+    EXPECT_THROW(build_hierarchy(s, "bvh-sah", {"max_prims=zero"}), InputError);
+    EXPECT_THROW(build_hierarchy(s, "bvh-sah", {"max_prims=0"}), InputError);
+    EXPECT_THROW(build_hierarchy(s, "bvh-sah", {"order=sideways"}), InputError);
+    EXPECT_THROW(build_hierarchy(s, "bvh-sah", {"noequals"}), InputError);
+    EXPECT_NO_THROW(build_hierarchy(s, "bvh-sah", {"max_prims=2", "bins=8"}));
+}
+
+}  // namespace
+}  // namespace rtcost::test

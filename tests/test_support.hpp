@@ -1,0 +1,107 @@
+#pragma once
+// Helpers shared by the tests: where the shared scenes are, the hard rays every hierarchy must
+// get right, and the comparison of two hit lists.
+
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "rtcost/hierarchy.hpp"
+#include "rtcost/io.hpp"
+#include "rtcost/rays.hpp"
+#include "rtcost/trace.hpp"
+
+namespace rtcost::test {
+
+/// `../shared` beside the repository (RTCOST_SHARED overrides it).
+inline std::string shared_dir() {
+    if (const char* env = std::getenv("RTCOST_SHARED")) return env;
+    return RTCOST_SHARED_DIR;
+}
+
+inline std::string spd_path(const std::string& scene) { return shared_dir() + "/scenes/spd/" + scene + ".nff"; }
+
+/// Skips the calling test when the shared SPD scene is not present.
+#define RTCOST_REQUIRE_SPD(name)                                                                 \
+    do {                                                                                         \
+        if (!std::filesystem::exists(::rtcost::test::spd_path(name)))                            \
+            GTEST_SKIP() << "shared scene " << ::rtcost::test::spd_path(name) << " not present"; \
+    } while (0)
+
+/// Random rays plus the hard cases: axis-parallel rays (two zero direction components), rays
+/// with one zero component, rays aimed exactly at primitive vertices and at edge midpoints, and
+/// rays starting inside the scene box (random_rays starts a third of its rays inside).
+inline std::vector<Ray> hard_rays(const Scene& s, std::size_t n_random, std::uint64_t seed) {
+    std::vector<Ray> rays = random_rays(s.bounds(), n_random, seed);
+    std::vector<Ray> extra = random_rays(s.bounds(), 6000, seed + 1);
+    for (std::size_t i = 0; i < extra.size(); ++i) {
+        Ray r = extra[i];
+        int axis = static_cast<int>(i % 3);
+        if (i % 2 == 0) {  // axis-parallel
+            Vec3 d{0, 0, 0};
+            d[axis] = (i % 4 == 0) ? 1.0f : -1.0f;
+            r.d = d;
+        } else {  // one zero component
+            r.d[axis] = 0;
+            if (r.d == Vec3{0, 0, 0}) r.d[(axis + 1) % 3] = 1;
+        }
+        rays.push_back(r);
+    }
+    // Aim at vertices, edge midpoints and sphere centres of a spread of primitives.
+    std::vector<Ray> origins = random_rays(s.bounds(), 4000, seed + 2);
+    for (std::size_t i = 0; i < origins.size(); ++i) {
+        std::uint32_t id = static_cast<std::uint32_t>((i * 2654435761u) % s.size());
+        const PrimRef& p = s.prims[id];
+        Vec3 target;
+        switch (p.kind) {
+            case PrimKind::Triangle: {
+                const Triangle& t = s.triangles[p.index];
+                target = (i % 2) ? t.v0 : (t.v0 + t.v1) * 0.5f;
+                break;
+            }
+            case PrimKind::Polygon: {
+                const Polygon& poly = s.polygons[p.index];
+                Vec3 a = s.polygon_vertices[poly.first], b = s.polygon_vertices[poly.first + 1];
+                target = (i % 2) ? a : (a + b) * 0.5f;
+                break;
+            }
+            case PrimKind::Sphere: target = s.spheres[p.index].center; break;
+            case PrimKind::Cone: target = s.cones[p.index].base; break;
+        }
+        Ray r = origins[i];
+        r.d = target - r.o;
+        if (r.d == Vec3{0, 0, 0}) continue;
+        rays.push_back(r);
+    }
+    return rays;
+}
+
+/// Closest hits through `h`.
+inline std::vector<Hit> closest_hits(const Hierarchy& h, std::span<const Ray> rays) {
+    return trace_rays(h, rays).hits;
+}
+
+/// Counts rays where `got` disagrees with `want`: hit/miss differ, or t differs by more than
+/// `rel_tol` relative (0: exactly). A different primitive at the same t (a shared edge) agrees.
+inline std::size_t count_mismatches(std::span<const Hit> want, std::span<const Hit> got, float rel_tol,
+                                    std::string* first = nullptr) {
+    std::size_t bad = 0;
+    for (std::size_t i = 0; i < want.size(); ++i) {
+        bool ok = want[i].hit() == got[i].hit();
+        if (ok && want[i].hit()) {
+            float tol = rel_tol * std::fabs(want[i].t);
+            ok = std::fabs(want[i].t - got[i].t) <= tol;
+        }
+        if (!ok && bad++ == 0 && first) {
+            *first = "ray " + std::to_string(i) + ": want prim " + std::to_string(want[i].prim) + " t " +
+                     std::to_string(want[i].t) + ", got prim " + std::to_string(got[i].prim) + " t " +
+                     std::to_string(got[i].t);
+        }
+    }
+    return bad;
+}
+
+}  // namespace rtcost::test
