@@ -24,6 +24,7 @@ namespace rtcost {
 enum class Query {
     Closest,  ///< nearest hit in (tmin, tmax)
     Any,      ///< any hit in (tmin, tmax) (occlusion); the hit reported is the first one found
+    All,      ///< visit everything the segment meets, never stop early; reports the closest hit
 };
 
 /// One node of a hierarchy as the cost model sees it (see the cost-model docs): a region, an
@@ -31,19 +32,32 @@ enum class Query {
 /// operations one visit costs, and either children or the primitives of a leaf.
 struct ModelNode {
     Box3 region;                 ///< R(A): the node's box (a BVH node's bounding box)
-    bool has_bv = false;         ///< a box test against `region` precedes entering the node
+    bool has_bv = false;         ///< a box test against `bv` precedes entering the node's children
+    Box3 bv;                     ///< the bounding volume tested (BVH: equals `region`)
     std::int8_t axis = -1;       ///< separating plane axis, -1 for none (BVH)
-    float plane = 0;             ///< separating plane position on `axis`
+    float split = 0;             ///< separating plane position on `axis`
     std::uint32_t first = 0;     ///< first child (in ModelTree::nodes) or first primitive (in ModelTree::prims)
     std::uint32_t count = 0;     ///< number of children, or of primitives for a leaf
     bool leaf = true;
-    int depth = 0;               ///< root at 0
+    int depth = 0;               ///< root at 0 (in model-tree levels)
+    /// Operations one visit of this node performs besides primitive tests, in counter units
+    /// (e.g. a kd-median node: one box and one plane; an octree's three binary levels: the
+    /// first carries the visit, the other two none).
+    float box = 0, plane = 0, hop = 0, classify = 0;
+    bool step = true;            ///< a visit is one traversal step (N_TS)
 };
 
 /// A hierarchy flattened for the model: `nodes[0]` is the root; the children of a node are
 /// contiguous. Binary for space subdivisions; a BVH node may have more than two children
 /// (Goldsmith and Salmon's trees are n-ary), each entered through its own box test.
 struct ModelTree {
+    std::string family;                ///< "bvh", "bsp", "octree", "kd", "grid", "rc5d"
+    /// Leaves are found by descending from the root for every cell (Kaplan's and Glassner's
+    /// `locate` traversal): each leaf visit pays the operations of all its ancestors again.
+    bool locate = false;
+    /// Operations every ray pays once whatever it meets (e.g. the root box test), and those a
+    /// ray that enters the root pays once more or less (a grid's first cell has no hop: -1).
+    float per_ray_box = 1, per_entry_hop = 0;
     std::vector<ModelNode> nodes;
     std::vector<std::uint32_t> prims;  ///< leaf primitive references
 };
@@ -91,6 +105,10 @@ public:
     /// holds the first hit found (not necessarily the closest).
     virtual bool any(const Ray& ray, Hit& hit) const = 0;
     virtual bool any(const Ray& ray, Hit& hit, RayCounters& counters) const = 0;
+    /// All-hits query (the cost model's no-termination case): every node and primitive the
+    /// segment meets is visited; `hit` receives the closest hit.
+    virtual void all(const Ray& ray, Hit& hit) const = 0;
+    virtual void all(const Ray& ray, Hit& hit, RayCounters& counters) const = 0;
 
     /// Structural statistics (N_IN, N_V, N_EV, N_OIV, depth, bytes, build seconds).
     StructureStats structure() const {
@@ -143,12 +161,24 @@ public:
         return self().template trace<Count, Query::Any>(ray, hit, c);
     }
 
+    void all(const Ray& ray, Hit& hit) const final {
+        NoCount c;
+        self().template trace<NoCount, Query::All>(ray, hit, c);
+    }
+    void all(const Ray& ray, Hit& hit, RayCounters& counters) const final {
+        Count c{counters};
+        ++counters.rays;
+        self().template trace<Count, Query::All>(ray, hit, c);
+    }
+
 private:
     const Derived& self() const { return static_cast<const Derived&>(*this); }
 };
 
 /// Tests primitive `id` against `ray` and, when it is hit nearer than `hit.t`, records it.
 /// Counts one primitive test of the primitive's kind. Shared by every traversal's leaves.
+/// Traversals implement Query::All by never terminating early or culling by `hit.t`
+/// (`if constexpr (Q != Query::All)` around every such test).
 template <class C>
 inline bool test_prim(const Scene& scene, std::uint32_t id, const Ray& ray, Hit& hit, C& counting) {
     counting.prim(scene.kind(id));

@@ -18,7 +18,8 @@ std::vector<Ray> camera_rays(const Camera& cam, int width, int height);
 
 /// `n` isotropic random lines through `box` under the invariant measure of lines (uniform
 /// direction on the sphere, then a uniform point on the box's projection perpendicular to it),
-/// clipped to the box: origin at the entry point, unit direction, (0, chord length).
+/// clipped to the box: origin at the entry point, unit direction, (0, chord length), both ends
+/// extended by 1e-4 of the box's half-diagonal so that geometry on the box's faces is met.
 std::vector<Ray> line_rays(const Box3& box, std::size_t n, std::uint64_t seed);
 
 /// `n` rays for correctness tests: origins uniform in `box` grown by half its size on each side

@@ -33,11 +33,17 @@ TraceResult trace_rays(const Hierarchy& h, std::span<const Ray> rays, const Trac
         for (std::size_t i = range.begin(); i != range.end(); ++i) {
             Hit& hit = res.hits[i];
             if constexpr (kCount) {
-                if (opt.query == Query::Closest) h.closest(rays[i], hit, *counters);
-                else h.any(rays[i], hit, *counters);
+                switch (opt.query) {
+                    case Query::Closest: h.closest(rays[i], hit, *counters); break;
+                    case Query::Any: h.any(rays[i], hit, *counters); break;
+                    case Query::All: h.all(rays[i], hit, *counters); break;
+                }
             } else {
-                if (opt.query == Query::Closest) h.closest(rays[i], hit);
-                else h.any(rays[i], hit);
+                switch (opt.query) {
+                    case Query::Closest: h.closest(rays[i], hit); break;
+                    case Query::Any: h.any(rays[i], hit); break;
+                    case Query::All: h.all(rays[i], hit); break;
+                }
             }
         }
         if (opt.progress) {

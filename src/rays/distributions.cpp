@@ -55,6 +55,7 @@ std::vector<Ray> line_rays(const Box3& box, std::size_t n, std::uint64_t seed) {
     rays.reserve(n);
     Vec3 c = box.center();
     float radius = 0.5f * length(box.extent());
+    const float margin = 1e-4f * radius;
     while (rays.size() < n) {
         Vec3 d = rng.direction();
         // Uniform point on the disc of the bounding sphere's projection, then keep it when the
@@ -75,7 +76,9 @@ std::vector<Ray> line_rays(const Box3& box, std::size_t n, std::uint64_t seed) {
             t1 = tf < t1 ? tf : t1;
         }
         if (!(t0 < t1)) continue;
-        rays.push_back(Ray{o + d * t0, d, 0, t1 - t0});
+        // The segment reaches a hair past the box on both ends, so that geometry lying exactly
+        // on the box's faces (a ground polygon) is met whatever the rounding of the entry point.
+        rays.push_back(Ray{o + d * (t0 - margin), d, 0, t1 - t0 + 2 * margin});
     }
     return rays;
 }

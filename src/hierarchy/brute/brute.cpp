@@ -24,6 +24,19 @@ public:
         return found;
     }
 
+    /// One leaf holding every primitive, entered with no box test.
+    ModelTree model_tree() const override {
+        ModelTree t;
+        t.family = "bvh";
+        t.per_ray_box = 0;
+        ModelNode leaf;
+        leaf.region = scene_->bounds();
+        leaf.count = static_cast<std::uint32_t>(scene_->size());
+        t.nodes.push_back(leaf);
+        for (std::uint32_t id = 0; id < scene_->size(); ++id) t.prims.push_back(id);
+        return t;
+    }
+
 protected:
     StructureStats compute_structure() const override {
         StructureStats s;

@@ -33,6 +33,7 @@ StructureStats Bvh::compute_structure() const {
 
 ModelTree Bvh::model_tree() const {
     ModelTree t;
+    t.family = "bvh";
     t.nodes.resize(d_.nodes.size());
     t.prims = d_.refs;
     for (std::size_t i = 0; i < d_.nodes.size(); ++i) {
@@ -40,6 +41,8 @@ ModelTree Bvh::model_tree() const {
         ModelNode& m = t.nodes[i];
         m.region = n.box;
         m.has_bv = true;
+        m.bv = n.box;
+        m.box = n.leaf ? 0.0f : static_cast<float>(n.count);  // a visit tests every child's box
         m.first = n.index;
         m.count = n.count;
         m.leaf = n.leaf;

@@ -66,7 +66,9 @@ public:
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        return ordered_ ? walk<C, Q, true>(ray, hit, counting) : walk<C, Q, false>(ray, hit, counting);
+        // Query::All never cuts by a hit found, which is the unordered walk.
+        if constexpr (Q == Query::All) return walk<C, Q, false>(ray, hit, counting);
+        else return ordered_ ? walk<C, Q, true>(ray, hit, counting) : walk<C, Q, false>(ray, hit, counting);
     }
 
 protected:

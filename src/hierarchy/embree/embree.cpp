@@ -115,6 +115,10 @@ public:
         return any(ray, hit);
     }
 
+    // Embree always terminates at the closest hit; all-hits is not a mode it has.
+    void all(const Ray& ray, Hit& hit) const override { closest(ray, hit); }
+    void all(const Ray& ray, Hit& hit, RayCounters& c) const override { closest(ray, hit, c); }
+
 protected:
     StructureStats compute_structure() const override {
         StructureStats s;
