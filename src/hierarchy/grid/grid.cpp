@@ -1,0 +1,290 @@
+// `grid`: resolution formulas, the build (CSR cell references), structure statistics, the
+// model tree and the registration.
+#include "grid.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+
+#include <fmt/format.h>
+
+#include "rtcost/error.hpp"
+
+namespace rtcost::grid {
+namespace {
+
+[[noreturn]] void bad_res(std::string_view spec, const std::string& why) {
+    throw InputError("--set", 0, fmt::format("res={}: {}", spec, why));
+}
+
+// "AxBxC" with each part an integer in [1, kMaxRes].
+std::array<int, 3> parse_explicit(std::string_view spec) {
+    std::array<int, 3> r{};
+    std::size_t pos = 0;
+    for (int a = 0; a < 3; ++a) {
+        std::size_t end = a < 2 ? spec.find('x', pos) : spec.size();
+        if (end == std::string_view::npos) bad_res(spec, "expected regular, woo, hetero or AxBxC");
+        std::string_view part = spec.substr(pos, end - pos);
+        long long v = 0;
+        auto [p, ec] = std::from_chars(part.data(), part.data() + part.size(), v);
+        if (part.empty() || ec != std::errc() || p != part.data() + part.size())
+            bad_res(spec, "expected regular, woo, hetero or AxBxC");
+        if (v < 1 || v > kMaxRes) bad_res(spec, fmt::format("each resolution must be in [1, {}]", kMaxRes));
+        r[a] = static_cast<int>(v);
+        pos = end + 1;
+    }
+    return r;
+}
+
+std::uint64_t product(const std::array<int, 3>& r) {
+    return static_cast<std::uint64_t>(r[0]) * static_cast<std::uint64_t>(r[1]) * static_cast<std::uint64_t>(r[2]);
+}
+
+// Clamp to [1, kMaxRes] in double first (formulas can overflow int), then shrink uniformly
+// until the cell count is within kMaxCells.
+std::array<int, 3> clamp_res(const std::array<double, 3>& v) {
+    std::array<int, 3> r{};
+    for (int a = 0; a < 3; ++a) r[a] = static_cast<int>(std::clamp(std::isfinite(v[a]) ? v[a] : double(kMaxRes), 1.0, double(kMaxRes)));
+    if (product(r) > kMaxCells) {
+        const double s = std::cbrt(static_cast<double>(kMaxCells) / static_cast<double>(product(r)));
+        for (int a = 0; a < 3; ++a) r[a] = std::max(1, static_cast<int>(std::floor(r[a] * s + 1e-9)));
+        while (product(r) > kMaxCells) --*std::max_element(r.begin(), r.end());
+    }
+    return r;
+}
+
+}  // namespace
+
+std::array<int, 3> resolution(std::string_view spec, double density, std::size_t n, const Box3& box) {
+    const bool formula = spec == "regular" || spec == "woo" || spec == "hetero";
+    std::array<int, 3> explicit_res{1, 1, 1};
+    if (!formula) {
+        explicit_res = parse_explicit(spec);
+        if (product(explicit_res) > kMaxCells)
+            bad_res(spec, fmt::format("{} cells exceed the limit of {}", product(explicit_res), kMaxCells));
+    }
+    if (box.empty() || n == 0) return {1, 1, 1};
+    std::array<double, 3> ext{};
+    for (int a = 0; a < 3; ++a) ext[a] = static_cast<double>(box.hi[a]) - box.lo[a];
+    const double max_ext = std::max({ext[0], ext[1], ext[2]});
+    if (!(max_ext > 0)) return {1, 1, 1};
+
+    if (!formula) {
+        // The user's resolution, except that a zero-extent axis has nothing to subdivide.
+        for (int a = 0; a < 3; ++a)
+            if (!(ext[a] > 0)) explicit_res[a] = 1;
+        return explicit_res;
+    }
+
+    std::array<bool, 3> flat{};
+    for (int a = 0; a < 3; ++a) flat[a] = ext[a] <= kFlat * max_ext;
+    const double dn = density * static_cast<double>(n);
+    std::array<double, 3> v{1, 1, 1};
+    if (spec == "regular") {
+        // As the issue states it: D scales the per-axis count, round(D * N^(1/3)).
+        const double k = std::round(density * std::cbrt(static_cast<double>(n)));
+        v = {k, k, k};
+    } else if (spec == "woo") {
+        // L = (D N)^(1/3); res_i = max(1, floor(size_i / max_size * L)). The 1e-9 keeps exact
+        // products (a cube of 1000 primitives) from losing a cell to rounding in cbrt.
+        const double l = std::cbrt(dn);
+        for (int a = 0; a < 3; ++a) v[a] = std::max(1.0, std::floor(ext[a] / max_ext * l + 1e-9));
+    } else {
+        // Klimaszewski: cells as cubic as possible, about D N of them. A flat axis would divide
+        // by zero (or blow x and y up for a nearly flat one); it gets one cell, and in the
+        // formulas the extent that makes that one cell cubic: the cell size c of the lower-
+        // dimensional problem, c = (product of the other extents / D N)^(1/k). With it the
+        // formulas reduce exactly to the 2D (1D) ones.
+        std::array<double, 3> s = ext;
+        double vol = 1;
+        int k = 0;
+        for (int a = 0; a < 3; ++a)
+            if (!flat[a]) { vol *= ext[a]; ++k; }
+        const double c = std::pow(vol / dn, 1.0 / k);
+        for (int a = 0; a < 3; ++a)
+            if (flat[a]) s[a] = c;
+        const double x = std::max(1.0, std::round(std::cbrt(dn * s[0] * s[0] / (s[1] * s[2]))));
+        const double y = std::max(1.0, std::round(std::sqrt(dn * s[1] / (x * s[2]))));
+        const double z = std::max(1.0, std::round(dn / (x * y)));
+        v = {x, y, z};
+    }
+    for (int a = 0; a < 3; ++a)
+        if (flat[a]) v[a] = 1;
+    return clamp_res(v);
+}
+
+Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox)
+    : HierarchyImpl(s), box_(s.bounds()), empty_(s.empty() || s.bounds().empty()), res_(res), mailbox_(mailbox) {
+    if (empty_) {
+        res_ = {1, 1, 1};
+        box_ = Box3{{0, 0, 0}, {0, 0, 0}};
+    }
+    // Boundaries in double, rounded once: non-decreasing, first and last exactly the box faces.
+    for (int a = 0; a < 3; ++a) {
+        const int r = res_[a];
+        const double lo = box_.lo[a], hi = box_.hi[a];
+        planes_[a].resize(r + 1);
+        for (int i = 0; i <= r; ++i) planes_[a][i] = static_cast<float>(lo + (hi - lo) * i / r);
+        planes_[a][0] = box_.lo[a];
+        planes_[a][r] = box_.hi[a];
+        const float ext = box_.hi[a] - box_.lo[a];
+        inv_cell_[a] = ext > 0 ? static_cast<float>(r) / ext : 0.0f;
+    }
+
+    // References as (cell, id) pairs in id order, then a counting sort into CSR: each cell's ids
+    // come out ascending.
+    const std::uint64_t cells = product(res_);
+    std::vector<std::uint64_t> pair_cell;
+    std::vector<std::uint32_t> pair_id;
+    if (!empty_) {
+        for (std::uint32_t id = 0; id < s.size(); ++id) {
+            const Box3 pb = s.prim_bounds(id);
+            if (pb.empty()) continue;
+            int lo[3], hi[3];
+            for (int a = 0; a < 3; ++a) {
+                const float* pl = planes_[a].data();
+                const int r = res_[a];
+                // First cell whose upper boundary reaches pb.lo, last whose lower one is <= pb.hi.
+                lo[a] = static_cast<int>(std::lower_bound(pl + 1, pl + r + 1, pb.lo[a]) - (pl + 1));
+                hi[a] = static_cast<int>(std::upper_bound(pl, pl + r, pb.hi[a]) - pl) - 1;
+                lo[a] = std::min(lo[a], r - 1);
+                hi[a] = std::max(hi[a], 0);
+            }
+            for (int k = lo[2]; k <= hi[2]; ++k)
+                for (int j = lo[1]; j <= hi[1]; ++j)
+                    for (int i = lo[0]; i <= hi[0]; ++i)
+                        if (spatial::overlaps(s, id, pb, cell_box(i, j, k), assign)) {
+                            pair_cell.push_back(cell_index(i, j, k));
+                            pair_id.push_back(id);
+                        }
+        }
+    }
+    if (pair_id.size() > std::numeric_limits<std::uint32_t>::max())
+        throw InputError("--set", 0,
+                         fmt::format("grid {}x{}x{} needs {} references, more than 2^32; choose a coarser resolution",
+                                     res_[0], res_[1], res_[2], pair_id.size()));
+    offsets_.assign(cells + 1, 0);
+    for (std::uint64_t c : pair_cell) ++offsets_[c + 1];
+    for (std::uint64_t c = 0; c < cells; ++c) offsets_[c + 1] += offsets_[c];
+    refs_.resize(pair_id.size());
+    std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
+    for (std::size_t p = 0; p < pair_id.size(); ++p) refs_[fill[pair_cell[p]]++] = pair_id[p];
+}
+
+StructureStats Grid::compute_structure() const {
+    StructureStats s;
+    s.interior = 1;  // the grid itself: the one node a ray enters before its first cell
+    s.leaves = cell_count();
+    for (std::uint64_t c = 0; c < cell_count(); ++c) s.empty_leaves += offsets_[c] == offsets_[c + 1];
+    s.references = refs_.size();
+    s.depth = 1;
+    s.bytes = (offsets_.size() + refs_.size()) * sizeof(std::uint32_t);
+    for (const auto& p : planes_) s.bytes += p.size() * sizeof(float);
+    return s;
+}
+
+// The cost model's view: the balanced binary split of the cell index ranges (the longest range
+// halved, the lower half getting floor(len/2) cells, ties to the lowest axis) down to single
+// cells. The 3DDDA never visits these binary nodes: they only carry the regions and planes the
+// probabilities are computed over, so they cost nothing (hop 0) and are no traversal step,
+// except the root, which stands for the grid box and is counted like the traversal's
+// interior(0). Each cell visit is a step and costs one hop; per_entry_hop = -1 because the
+// first cell is reached without one.
+ModelTree Grid::model_tree() const {
+    ModelTree t;
+    t.family = "grid";
+    t.per_ray_box = 1;
+    t.per_entry_hop = -1;
+    t.prims = refs_;
+    struct Range {
+        int lo[3], hi[3];  // cell index ranges, hi exclusive
+    };
+    std::vector<Range> work;
+    work.push_back({{0, 0, 0}, {res_[0], res_[1], res_[2]}});
+    t.nodes.emplace_back();
+    auto region = [&](const Range& r) {
+        return Box3{{planes_[0][r.lo[0]], planes_[1][r.lo[1]], planes_[2][r.lo[2]]},
+                    {planes_[0][r.hi[0]], planes_[1][r.hi[1]], planes_[2][r.hi[2]]}};
+    };
+    if (cell_count() == 1) {
+        // One cell: the grid node above it, so that the model counts the same steps and depths.
+        ModelNode& root = t.nodes[0];
+        root.region = region(work[0]);
+        root.leaf = false;
+        root.first = 1;
+        root.count = 1;
+        root.step = true;
+        ModelNode leaf;
+        leaf.region = root.region;
+        leaf.depth = 1;
+        leaf.first = offsets_[0];
+        leaf.count = offsets_[1] - offsets_[0];
+        leaf.hop = 1;
+        t.nodes.push_back(leaf);
+        return t;
+    }
+    t.nodes.reserve(2 * cell_count() - 1);
+    work.reserve(2 * cell_count() - 1);
+    for (std::size_t n = 0; n < work.size(); ++n) {
+        const Range r = work[n];
+        ModelNode& m = t.nodes[n];
+        m.region = region(r);
+        int axis = 0;
+        for (int a = 1; a < 3; ++a)
+            if (r.hi[a] - r.lo[a] > r.hi[axis] - r.lo[axis]) axis = a;
+        const int len = r.hi[axis] - r.lo[axis];
+        if (len == 1) {
+            const std::uint64_t c = cell_index(r.lo[0], r.lo[1], r.lo[2]);
+            m.leaf = true;
+            m.first = offsets_[c];
+            m.count = offsets_[c + 1] - offsets_[c];
+            m.hop = 1;
+            m.step = true;
+            continue;
+        }
+        const int mid = r.lo[axis] + len / 2;
+        m.leaf = false;
+        m.axis = static_cast<std::int8_t>(axis);
+        m.split = planes_[axis][mid];
+        m.first = static_cast<std::uint32_t>(t.nodes.size());
+        m.count = 2;
+        m.hop = 0;
+        m.step = n == 0;
+        const int depth = m.depth;
+        Range left = r, right = r;
+        left.hi[axis] = mid;
+        right.lo[axis] = mid;
+        work.push_back(left);
+        work.push_back(right);
+        ModelNode child;
+        child.depth = depth + 1;
+        t.nodes.push_back(child);  // invalidates `m`
+        t.nodes.push_back(child);
+    }
+    return t;
+}
+
+namespace {
+
+const Registration reg{
+    {"grid",
+     "Fujimoto's uniform grid, traversed by the 3DDDA of Amanatides and Woo",
+     // Default hetero: of the three formulas the only one that gives about D*N cells, as cubic as
+     // possible, whatever the box's shape (the common rule of Cleary-Wyvill, Havran, Wald et al.);
+     // woo gives D*N only for a cube (balls: 361 cells for 7382 primitives).
+     {{"res", "hetero",
+       "hetero: Klimaszewski's cubic cells, about D*N of them; woo: L=(D*N)^(1/3), res_i=floor(size_i/max_size*L); "
+       "regular: round(D*N^(1/3)) on every axis; or AxBxC. Each axis in [1, 1024], a flat axis gets 1, formula "
+       "grids are scaled down to at most 2^24 cells"},
+      {"density", "1", "D in the resolution formulas (cells per primitive for woo and hetero); ignored for AxBxC"},
+      spatial::kAssignParam,
+      spatial::kMailboxParam},
+     [](const Scene& s, const Params& p) {
+         const double density = p.real("density", 1e-3, 1e3);
+         const std::array<int, 3> res = resolution(p.str("res"), density, s.size(), s.bounds());
+         return std::make_unique<Grid>(s, res, spatial::parse_assign(p), p.flag("mailbox"));
+     }}};
+
+}  // namespace
+}  // namespace rtcost::grid
