@@ -1,0 +1,93 @@
+#pragma once
+/// \file model.hpp
+/// Subramanian and Fussell's cost model over any hierarchy's model tree (hierarchy.hpp).
+///
+/// The recursion Cost(T_A) = Cost(A) + a H(B) + b H(C) + (1-a-b)[g (H(B) + (1-P_B) H(C)) +
+/// (1-g)(H(C) + (1-P_C) H(B))] is linear in the children's costs, so it is evaluated as visit
+/// probabilities: pi(root) = 1, pi(child) = pi(parent) q(child), and the predicted cost is
+/// the sum over nodes of pi(N) times the operations a visit of N performs.
+
+#include <array>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "rtcost/hierarchy.hpp"
+
+namespace rtcost {
+
+/// Expected operations per ray, by kind (the counters' units).
+struct CostVector {
+    double box = 0, plane = 0, hop = 0, classify = 0;
+    std::array<double, kPrimKinds> prim{};
+    double steps = 0, leaves = 0, empty_leaves = 0;
+
+    double prim_tests() const { return prim[0] + prim[1] + prim[2] + prim[3]; }
+};
+
+/// Cost of one operation of each kind (default 1: pure operation counts; calibrated: ns).
+struct UnitCosts {
+    double box = 1, plane = 1, hop = 1, classify = 1;
+    std::array<double, kPrimKinds> prim{1, 1, 1, 1};
+    bool calibrated = false;  ///< nanoseconds fitted by `rtcost calibrate`
+
+    double scalar(const CostVector& c) const;
+    /// Reads a costs file (JSON `{"box": ns, "plane": ns, ..., "prim": {"triangle": ns, ...}}`).
+    static UnitCosts read(const std::string& path);
+};
+
+/// The measured counterpart of a CostVector: per-ray means of the counters.
+CostVector measured_cost(const RayCounters& c);
+
+enum class Preset {
+    Exact,  ///< every operation the traversal performs, in the counters' units
+    Paper,  ///< the seed paper's formulas per family, errata fixed
+};
+
+enum class Estimator {
+    Geometric,  ///< surface-area (Cauchy-Crofton) probabilities for isotropic lines; no rays traced
+    Sampled,    ///< probabilities counted from a training sample of rays
+};
+
+struct ModelOptions {
+    Preset preset = Preset::Exact;
+    /// Query::All: no early termination (P = 0 everywhere). Closest and Any terminate.
+    Query query = Query::Closest;
+};
+
+/// Per-node probabilities that drive the recursion.
+struct NodeProbabilities {
+    double handed = 0;  ///< segments handed to the node (sampled) or pi (geometric)
+    bool split = false;  ///< alpha, beta, gamma hold for this two-child node
+    double alpha = 0, beta = 0, gamma = 0.5;  ///< left only, right only, left first when both
+    /// Both children met: 1 - alpha - beta for a plane split; less for bounding volumes, whose
+    /// children need not cover their parent.
+    double both = 0;
+    double p_hit = 0;   ///< P: the segment handed to the node hits inside its region
+    double p_bv = 1;    ///< the segment meets the node's bounding volume (when it has one)
+};
+
+/// A prediction: the cost vector, its scalar, and visit probabilities per model depth.
+struct Prediction {
+    CostVector cost;
+    double scalar = 0;
+    std::vector<double> visits_by_depth;  ///< expected traversal steps per depth (the counters' units)
+    std::string estimator, preset;
+    /// How P over several primitives was approximated (geometric estimator).
+    std::string note;
+};
+
+/// Geometric estimator: probabilities from surface areas of each node's entry region for
+/// isotropic lines through the root box. P of a node over several primitives is approximated
+/// as 1 - prod(1 - p_i), p_i = S_i / S(region) with S_i the primitive's area seen from both
+/// sides (2x for flat primitives), scaled by the share of its bounding box inside the region.
+Prediction predict_geometric(const ModelTree& tree, const Scene& scene, const ModelOptions& opt,
+                             const UnitCosts& costs = {});
+
+/// Sampled estimator: a probe walk of the model tree with each training ray's true closest hit
+/// fills alpha, beta, gamma, P per node; the recursion then predicts from those ratios.
+/// `closest` holds the training rays' closest hits (from any exact hierarchy).
+Prediction predict_sampled(const ModelTree& tree, const Scene& scene, std::span<const Ray> training,
+                           std::span<const Hit> closest, const ModelOptions& opt, const UnitCosts& costs = {});
+
+}  // namespace rtcost

@@ -1,0 +1,457 @@
+// The cost model's recursion, evaluated as visit probabilities over a hierarchy's model tree,
+// with the geometric and the sampled estimators and the `exact` and `paper` presets.
+#include "rtcost/model.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+#include <numbers>
+
+#include "rtcost/error.hpp"
+
+namespace rtcost {
+
+double UnitCosts::scalar(const CostVector& c) const {
+    double s = box * c.box + plane * c.plane + hop * c.hop + classify * c.classify;
+    for (int k = 0; k < kPrimKinds; ++k) s += prim[k] * c.prim[k];
+    return s;
+}
+
+UnitCosts UnitCosts::read(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, 0, "no such file");
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::parse_error& e) {
+        throw InputError(path, 0, std::string("not a costs file: ") + e.what());
+    }
+    UnitCosts u;
+    auto get = [&](const nlohmann::json& obj, const char* key, double& out) {
+        if (!obj.contains(key)) return;
+        if (!obj[key].is_number() || !std::isfinite(obj[key].get<double>()) || obj[key].get<double>() < 0)
+            throw InputError(path, 0, std::string("'") + key + "' must be a non-negative number");
+        out = obj[key].get<double>();
+    };
+    get(j, "box", u.box);
+    get(j, "plane", u.plane);
+    get(j, "hop", u.hop);
+    get(j, "classify", u.classify);
+    if (j.contains("prim")) {
+        for (int k = 0; k < kPrimKinds; ++k)
+            get(j["prim"], std::string(prim_kind_name(static_cast<PrimKind>(k))).c_str(), u.prim[k]);
+    }
+    u.calibrated = j.value("unit", "") == "ns";
+    return u;
+}
+
+CostVector measured_cost(const RayCounters& c) {
+    CostVector v;
+    double n = c.rays ? static_cast<double>(c.rays) : 1.0;
+    v.box = c.box / n;
+    v.plane = c.plane / n;
+    v.hop = c.hop / n;
+    v.classify = c.classify / n;
+    for (int k = 0; k < kPrimKinds; ++k) v.prim[k] = c.prim[k] / n;
+    v.steps = c.steps / n;
+    v.leaves = c.leaves / n;
+    v.empty_leaves = c.empty_leaves / n;
+    return v;
+}
+
+namespace {
+
+Box3 intersect(const Box3& a, const Box3& b) { return Box3{vmax(a.lo, b.lo), vmin(a.hi, b.hi)}; }
+
+/// Area of a box that may be flat (one or two zero extents) or empty.
+double surface(const Box3& b) {
+    if (b.empty()) return 0;
+    Vec3 e = b.extent();
+    return 2.0 * (double(e.x) * e.y + double(e.y) * e.z + double(e.z) * e.x);
+}
+
+/// The surface a line must cross to meet the primitive, for Cauchy-Crofton: flat primitives
+/// count both sides; an open cone or cylinder counts its convex hull (side and both rims' discs).
+double crofton_area(const Scene& s, std::uint32_t id) {
+    const PrimRef& p = s.prims[id];
+    switch (p.kind) {
+        case PrimKind::Triangle:
+        case PrimKind::Polygon: return 2.0 * s.prim_area(id);
+        case PrimKind::Sphere: return s.prim_area(id);
+        case PrimKind::Cone: {
+            const Cone& c = s.cones[p.index];
+            double rb = std::fabs(c.base_radius), ra = std::fabs(c.apex_radius);
+            return s.prim_area(id) + std::numbers::pi * (rb * rb + ra * ra);
+        }
+    }
+    return 0;
+}
+
+/// Share of a primitive's bounding box that lies in `region`, measured in the dimensions where
+/// the box has extent (a flat box by area, a line by length).
+double share_inside(const Box3& pb, const Box3& region) {
+    double f = 1;
+    for (int k = 0; k < 3; ++k) {
+        double ext = double(pb.hi[k]) - pb.lo[k];
+        if (ext <= 0) {
+            if (pb.lo[k] < region.lo[k] || pb.lo[k] > region.hi[k]) return 0;
+            continue;
+        }
+        double lo = std::max(pb.lo[k], region.lo[k]), hi = std::min(pb.hi[k], region.hi[k]);
+        f *= std::max(0.0, hi - lo) / ext;
+    }
+    return f;
+}
+
+struct Walk {
+    const ModelTree& t;
+    std::vector<int> parent;
+    std::vector<int> tdepth;      // traversal depth: number of step ancestors
+    std::vector<Box3> visit_box;  // V(N): where a segment must pass for N to be visited
+    std::vector<Box3> gate_box;   // V(N) within N's bounding volume, when it has one
+
+    explicit Walk(const ModelTree& tree) : t(tree) {
+        const std::size_t n = t.nodes.size();
+        parent.assign(n, -1);
+        tdepth.assign(n, 0);
+        visit_box.resize(n);
+        gate_box.resize(n);
+        visit_box[0] = t.nodes[0].region;
+        for (std::size_t i = 0; i < n; ++i) {
+            const ModelNode& m = t.nodes[i];
+            gate_box[i] = m.has_bv ? intersect(visit_box[i], m.bv) : visit_box[i];
+            if (m.leaf) continue;
+            for (std::uint32_t k = 0; k < m.count; ++k) {
+                std::uint32_t c = m.first + k;
+                parent[c] = static_cast<int>(i);
+                tdepth[c] = tdepth[i] + (m.step ? 1 : 0);
+                visit_box[c] = intersect(gate_box[i], t.nodes[c].region);
+            }
+        }
+    }
+};
+
+/// q(child | parent visited) for every node from per-node probabilities (the recursion's
+/// coefficients), then pi and the cost vector.
+Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodeProbabilities>& prob,
+                    const Scene& scene, const ModelOptions& opt, const UnitCosts& costs) {
+    const std::size_t n = t.nodes.size();
+    const bool terminate = opt.query != Query::All;
+    const bool paper = opt.preset == Preset::Paper;
+    std::vector<double> pi(n, 0.0);
+    pi[0] = 1.0;
+    Prediction out;
+    CostVector& c = out.cost;
+    auto add_visit = [&](int depth, double p) {
+        if (depth >= static_cast<int>(out.visits_by_depth.size())) out.visits_by_depth.resize(depth + 1, 0.0);
+        out.visits_by_depth[depth] += p;
+    };
+    // Operations of one node visit, scaled by `p` (visit) and `pg` (visit that passes the BV).
+    auto charge = [&](const ModelNode& m, double p, double pg, std::size_t i) {
+        if (paper) {
+            const std::string& f = t.family;
+            if (f == "bvh") {
+                c.box += p;  // the paper charges a node's own box test when it is entered
+            } else if (!m.leaf) {
+                if (f == "grid") c.hop += p;
+                else if (f == "rc5d") c.classify += p;
+                else if (f == "kd") { c.plane += p; c.box += p; }
+                else {
+                    // Kaplan/Glassner: 1_cmp + [g (1 - P_B) + (1 - g)] n_f, the far region's entry.
+                    const NodeProbabilities& q = prob[i];
+                    double pb = terminate ? prob[m.first].p_hit : 0.0;
+                    c.plane += p;
+                    c.box += p * (q.gamma * (1 - pb) + (1 - q.gamma));
+                }
+            }
+        } else {
+            c.box += p * m.box;
+            c.plane += pg * m.plane;
+            c.hop += pg * m.hop;
+            c.classify += pg * m.classify;
+        }
+    };
+
+    for (std::size_t i = 0; i < n; ++i) {
+        const ModelNode& m = t.nodes[i];
+        const NodeProbabilities& q = prob[i];
+        const double p = pi[i];
+        const double pg = p * (m.has_bv ? q.p_bv : 1.0);
+        if (!(t.locate && !m.leaf)) {
+            charge(m, p, pg, i);
+            if (m.step) {
+                c.steps += p;
+                add_visit(w.tdepth[i], p);
+            }
+        }
+        if (m.leaf) {
+            c.leaves += p;
+            if (m.count == 0) c.empty_leaves += p;
+            for (std::uint32_t k = 0; k < m.count; ++k)
+                c.prim[static_cast<int>(scene.kind(t.prims[m.first + k]))] += pg;
+            if (t.locate) {
+                // Every cell is found by a descent from the root: its ancestors' work again.
+                for (int a = w.parent[i]; a >= 0; a = w.parent[a]) {
+                    const ModelNode& am = t.nodes[a];
+                    charge(am, p, p, static_cast<std::size_t>(a));
+                    if (am.step) {
+                        c.steps += p;
+                        add_visit(w.tdepth[a], p);
+                    }
+                }
+            }
+            continue;
+        }
+        // Children's conditional visit probabilities.
+        if (q.split) {
+            const std::uint32_t b = m.first, cc = m.first + 1;
+            const double both = q.both;
+            const double pb = terminate ? prob[b].p_hit : 0.0, pc = terminate ? prob[cc].p_hit : 0.0;
+            double g = q.gamma;
+            pi[b] = pg * (q.alpha + both * (g + (1 - g) * (1 - pc)));
+            pi[cc] = pg * (q.beta + both * ((1 - g) + g * (1 - pb)));
+        } else {
+            // Bounding volume children (or any node without a plane): child X is entered when the
+            // segment meets it and no sibling met before it has ended the search. Siblings are
+            // taken in random order: E[prod over those before X of (1 - met_j P_j)] averaged over
+            // the position of X, by elementary symmetric polynomials.
+            const std::uint32_t k = m.count;
+            for (std::uint32_t x = 0; x < k; ++x) {
+                const std::uint32_t cx = m.first + x;
+                double met_x = prob[cx].handed;  // P(X | parent) stored in `handed`
+                double survive = 1.0;
+                if (terminate && k > 1) {
+                    std::vector<double> e(k, 0.0);  // e[j]: elementary symmetric polynomial of degree j
+                    e[0] = 1;
+                    std::uint32_t used = 0;
+                    for (std::uint32_t y = 0; y < k; ++y) {
+                        if (y == x) continue;
+                        double s = 1 - prob[m.first + y].handed * prob[m.first + y].p_hit;
+                        ++used;
+                        for (std::uint32_t j = used; j > 0; --j) e[j] += e[j - 1] * s;
+                    }
+                    // X at position j (0-based) has j random siblings before it: mean of
+                    // e_j / C(k-1, j) over j = 0..k-1.
+                    double sum = 0, binom = 1;
+                    for (std::uint32_t j = 0; j < k; ++j) {
+                        sum += e[j] / binom;
+                        binom = binom * (k - 1 - j) / (j + 1);
+                    }
+                    survive = sum / k;
+                }
+                pi[cx] = pg * met_x * survive;
+            }
+        }
+    }
+    // Every ray pays the root's clip test; rays that meet the root pay the per-entry terms.
+    c.box += t.per_ray_box;
+    c.hop += t.per_entry_hop * pi[0];
+    out.scalar = costs.scalar(c);
+    out.preset = paper ? "paper" : "exact";
+    return out;
+}
+
+/// Primitive area inside each node's region, bottom-up (Poisson form of P: 1 - exp(-sum p_i)).
+std::vector<double> area_inside(const ModelTree& t, const Walk& w, const Scene& scene) {
+    const std::size_t n = t.nodes.size();
+    std::vector<double> a(n, 0.0);
+    for (std::size_t i = n; i-- > 0;) {
+        const ModelNode& m = t.nodes[i];
+        if (m.leaf) {
+            for (std::uint32_t k = 0; k < m.count; ++k) {
+                std::uint32_t id = t.prims[m.first + k];
+                a[i] += crofton_area(scene, id) * share_inside(scene.prim_bounds(id), w.visit_box[i]);
+            }
+        } else {
+            for (std::uint32_t k = 0; k < m.count; ++k) a[i] += a[m.first + k];
+        }
+    }
+    return a;
+}
+
+}  // namespace
+
+Prediction predict_geometric(const ModelTree& t, const Scene& scene, const ModelOptions& opt, const UnitCosts& costs) {
+    if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
+    Walk w(t);
+    const std::size_t n = t.nodes.size();
+    std::vector<NodeProbabilities> prob(n);
+    std::vector<double> inside = area_inside(t, w, scene);
+    for (std::size_t i = 0; i < n; ++i) {
+        const ModelNode& m = t.nodes[i];
+        NodeProbabilities& q = prob[i];
+        double sv = surface(w.visit_box[i]), sg = surface(w.gate_box[i]);
+        q.p_bv = sv > 0 ? sg / sv : 0.0;
+        q.p_hit = sv > 0 ? 1 - std::exp(-inside[i] / sv) : 0.0;
+        if (m.leaf) continue;
+        if (m.axis >= 0 && m.count == 2) {
+            q.split = true;
+            double sl = surface(w.visit_box[m.first]), sr = surface(w.visit_box[m.first + 1]);
+            q.alpha = sg > 0 ? 1 - sr / sg : 0.0;
+            q.beta = sg > 0 ? 1 - sl / sg : 0.0;
+            q.both = std::max(0.0, 1 - q.alpha - q.beta);
+            q.gamma = 0.5;  // isotropic lines: either side first with equal probability
+        } else {
+            for (std::uint32_t k = 0; k < m.count; ++k) {
+                double sc = surface(w.visit_box[m.first + k]);
+                prob[m.first + k].handed = sg > 0 ? sc / sg : 0.0;
+            }
+        }
+    }
+    Prediction p = evaluate(t, w, prob, scene, opt, costs);
+    p.estimator = "geometric";
+    p.note = "P over several primitives: 1 - exp(-sum p_i), p_i = primitive area (both sides) x share of its "
+             "bounding box in the region / region area";
+    return p;
+}
+
+Prediction predict_sampled(const ModelTree& t, const Scene& scene, std::span<const Ray> training,
+                           std::span<const Hit> closest, const ModelOptions& opt, const UnitCosts& costs) {
+    if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
+    Walk w(t);
+    const std::size_t n = t.nodes.size();
+    // Per-node tallies of the probe walk.
+    struct Tally {
+        double handed = 0, gated = 0, left = 0, right = 0, both = 0, left_first = 0, hit = 0, met = 0;
+    };
+    std::vector<Tally> tally(n);
+    // P of a node: the ray's closest hit lies within the node's part of the segment. (For
+    // bounding volumes, whose boxes overlap, that hit may belong to a sibling's primitive: an
+    // approximation the model's own independence assumptions already make.)
+    const bool terminate = opt.query != Query::All;
+
+    struct Seg {
+        float t0, t1;
+        bool empty() const { return !(t0 <= t1); }
+    };
+    auto clip = [](const RayInv& ri, const Box3& b, Seg s) {
+        for (int k = 0; k < 3; ++k) {
+            float tn = (b.lo[k] - ri.o[k]) * ri.inv[k], tf = (b.hi[k] - ri.o[k]) * ri.inv[k];
+            if (tn > tf) std::swap(tn, tf);
+            s.t0 = tn > s.t0 ? tn : s.t0;
+            s.t1 = tf < s.t1 ? tf : s.t1;
+        }
+        return s;
+    };
+
+    // Bounding volumes overlap, so a hit inside a BVH node's box may belong to another subtree:
+    // there P counts only hits on the subtree's own primitives (leaves hold disjoint sets).
+    // Space subdivisions: a hit inside the node's part of the segment is one of its primitives.
+    const bool disjoint = t.family == "bvh";
+    std::vector<std::uint32_t> order(n, 0), end(n, 0), leaf_of(disjoint ? scene.size() : 0, 0);
+    if (disjoint) {
+        std::uint32_t next = 0;
+        std::vector<std::pair<std::uint32_t, bool>> dfs{{0, false}};
+        while (!dfs.empty()) {
+            auto [node, done] = dfs.back();
+            dfs.pop_back();
+            if (done) { end[node] = next; continue; }
+            order[node] = next++;
+            dfs.push_back({node, true});
+            const ModelNode& m = t.nodes[node];
+            if (m.leaf) {
+                for (std::uint32_t k = 0; k < m.count; ++k) leaf_of[t.prims[m.first + k]] = node;
+            } else {
+                for (std::uint32_t k = m.count; k-- > 0;) dfs.push_back({m.first + k, false});
+            }
+        }
+    }
+    auto ends_in = [&](std::uint32_t node, Seg s, std::size_t r) {
+        if (!closest[r].hit()) return false;
+        const float th = closest[r].t;
+        if (!(th >= s.t0 && th <= s.t1)) return false;
+        if (!disjoint) return true;
+        std::uint32_t leaf = leaf_of[static_cast<std::uint32_t>(closest[r].prim)];
+        return order[leaf] >= order[node] && order[leaf] < end[node];
+    };
+
+    for (std::size_t r = 0; r < training.size(); ++r) {
+        const Ray& ray = training[r];
+        const RayInv ri(ray);
+        // Explicit stack of (node, segment); children pushed so that the near one is walked first.
+        struct Item { std::uint32_t node; Seg s; };
+        std::vector<Item> stack;
+        Seg root = clip(ri, t.nodes[0].region, Seg{ray.tmin, ray.tmax});
+        if (root.empty()) continue;
+        tally[0].met += 1;
+        stack.push_back({0, root});
+        while (!stack.empty()) {
+            Item it = stack.back();
+            stack.pop_back();
+            const ModelNode& m = t.nodes[it.node];
+            Tally& ty = tally[it.node];
+            ty.handed += 1;
+            Seg s = it.s;
+            if (m.has_bv) {
+                s = clip(ri, m.bv, s);
+                if (s.empty()) continue;
+            }
+            ty.gated += 1;
+            ty.hit += ends_in(it.node, s, r);
+            if (m.leaf) continue;
+            if (m.count == 2) {
+                Seg sl = clip(ri, t.nodes[m.first].region, s), sr = clip(ri, t.nodes[m.first + 1].region, s);
+                bool l = !sl.empty(), rr = !sr.empty();
+                tally[m.first].met += l;
+                tally[m.first + 1].met += rr;
+                if (l && !rr) { ty.left += 1; stack.push_back({m.first, sl}); }
+                if (rr && !l) { ty.right += 1; stack.push_back({m.first + 1, sr}); }
+                if (l && rr) {
+                    ty.both += 1;
+                    bool left_first = sl.t0 < sr.t0 || (sl.t0 == sr.t0 && sl.t1 <= sr.t1);
+                    ty.left_first += left_first;
+                    Item near{left_first ? m.first : m.first + 1, left_first ? sl : sr};
+                    Item far{left_first ? m.first + 1 : m.first, left_first ? sr : sl};
+                    bool ends = terminate && ends_in(near.node, near.s, r);
+                    if (!ends) stack.push_back(far);
+                    stack.push_back(near);
+                }
+            } else {
+                for (std::uint32_t k = 0; k < m.count; ++k) {
+                    Seg sc = clip(ri, t.nodes[m.first + k].region, s);
+                    if (sc.empty()) continue;
+                    tally[m.first + k].met += 1;
+                    stack.push_back({m.first + k, sc});
+                }
+            }
+        }
+    }
+    std::vector<NodeProbabilities> prob(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const ModelNode& m = t.nodes[i];
+        const Tally& ty = tally[i];
+        NodeProbabilities& q = prob[i];
+        q.p_bv = ty.handed > 0 ? ty.gated / ty.handed : 0.0;
+        q.p_hit = ty.gated > 0 ? ty.hit / ty.gated : 0.0;
+        if (m.leaf) continue;
+        if (m.count == 2) {
+            q.split = true;
+            q.alpha = ty.gated > 0 ? ty.left / ty.gated : 0.0;
+            q.beta = ty.gated > 0 ? ty.right / ty.gated : 0.0;
+            q.both = ty.gated > 0 ? ty.both / ty.gated : 0.0;
+            q.gamma = ty.both > 0 ? ty.left_first / ty.both : 0.5;
+        } else {
+            for (std::uint32_t k = 0; k < m.count; ++k)
+                prob[m.first + k].handed = ty.gated > 0 ? tally[m.first + k].met / ty.gated : 0.0;
+        }
+    }
+    Prediction p = evaluate(t, w, prob, scene, opt, costs);
+    p.estimator = "sampled";
+    p.note = "probabilities from " + std::to_string(training.size()) + " training rays";
+    // The root is met by a share of the rays only; the recursion above is per ray that meets it.
+    double met = training.empty() ? 0.0 : tally[0].met / static_cast<double>(training.size());
+    CostVector& c = p.cost;
+    double root_box = t.per_ray_box;
+    auto scale = [&](double& v) { v *= met; };
+    c.box -= root_box;
+    scale(c.box); scale(c.plane); scale(c.hop); scale(c.classify);
+    for (auto& v : c.prim) scale(v);
+    scale(c.steps); scale(c.leaves); scale(c.empty_leaves);
+    for (auto& v : p.visits_by_depth) scale(v);
+    c.box += root_box;
+    p.scalar = costs.scalar(c);
+    return p;
+}
+
+}  // namespace rtcost
