@@ -17,7 +17,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-struct Run {
+struct CliRun {
     int code;
     std::string out, err;
 };
@@ -35,7 +35,7 @@ std::string slurp(const fs::path& p) {
     return ss.str();
 }
 
-Run run(const std::string& args) {
+CliRun run(const std::string& args) {
     fs::path d = temp_dir();
     std::string cmd = std::string(RTCOST_CLI) + " " + args + " > " + (d / "out").string() + " 2> " + (d / "err").string() +
                       " < /dev/null";
@@ -54,10 +54,10 @@ const char* kSmallNff =
     "l 0 5 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\np 3\n-3 -3 -2\n3 -3 -2\n0 3 -2\n";
 
 TEST(Cli, HelpListsSubcommandsAndHierarchyParameters) {
-    Run r = run("--help");
+    CliRun r = run("--help");
     EXPECT_EQ(r.code, 0);
     for (const char* s : {"info", "build", "trace", "list"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
-    Run t = run("trace --help");
+    CliRun t = run("trace --help");
     EXPECT_EQ(t.code, 0);
     EXPECT_NE(t.out.find("bvh-sah"), std::string::npos);
     EXPECT_NE(t.out.find("max_prims=8"), std::string::npos);  // defaults are printed
@@ -65,7 +65,7 @@ TEST(Cli, HelpListsSubcommandsAndHierarchyParameters) {
 }
 
 TEST(Cli, InfoJsonReportsCountsBoundsLightsCamera) {
-    Run r = run("info builtin:balls --json");
+    CliRun r = run("info builtin:balls --json");
     ASSERT_EQ(r.code, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["primitives"], 7382);
@@ -78,7 +78,7 @@ TEST(Cli, InfoJsonReportsCountsBoundsLightsCamera) {
 
 TEST(Cli, TraceJsonHasTimingsAndPerRayCounters) {
     fs::path scene = write("small.nff", kSmallNff);
-    Run r = run("trace " + scene.string() + " --hierarchy bvh-sah --rays camera --json --threads 1");
+    CliRun r = run("trace " + scene.string() + " --hierarchy bvh-sah --rays camera --json --threads 1");
     ASSERT_EQ(r.code, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["hierarchy"], "bvh-sah");
@@ -108,7 +108,7 @@ TEST(Cli, TraceWritesHitsMatchingBruteForce) {
     fs::path rf = temp_dir() / "four.rays";
     rtcost::write_rays(rf.string(), rays);
     fs::path hf = temp_dir() / "four.hits";
-    Run r = run("trace " + scene.string() + " -H brute --rays " + rf.string() + " --hits " + hf.string() + " -q");
+    CliRun r = run("trace " + scene.string() + " -H brute --rays " + rf.string() + " --hits " + hf.string() + " -q");
     ASSERT_EQ(r.code, 0) << r.err;
     auto hits = rtcost::read_hits(hf.string());
     ASSERT_EQ(hits.size(), 4u);
@@ -128,7 +128,7 @@ TEST(Cli, RayFileOfWrongSizeIsRejectedAndNoHitsFileWritten) {
     fs::path rf = write("bad.rays", std::string(33, '\0'));
     fs::path hf = temp_dir() / "never.hits";
     fs::remove(hf);
-    Run r = run("trace builtin:tetra:2 --rays " + rf.string() + " --hits " + hf.string());
+    CliRun r = run("trace builtin:tetra:2 --rays " + rf.string() + " --hits " + hf.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find(rf.string()), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("not a multiple of 32"), std::string::npos) << r.err;
@@ -140,14 +140,14 @@ TEST(Cli, RayFileWithNaNNamesTheRay) {
     rays[2].o.y = std::nanf("");
     fs::path rf = temp_dir() / "nan.rays";
     rtcost::write_rays(rf.string(), rays);
-    Run r = run("trace builtin:tetra:2 --rays " + rf.string());
+    CliRun r = run("trace builtin:tetra:2 --rays " + rf.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("ray 2"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("not finite"), std::string::npos) << r.err;
 }
 
 TEST(Cli, MissingSceneFileIsAClearError) {
-    Run r = run("info /no/such/scene.nff");
+    CliRun r = run("info /no/such/scene.nff");
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("/no/such/scene.nff"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("no such file"), std::string::npos) << r.err;
@@ -155,52 +155,52 @@ TEST(Cli, MissingSceneFileIsAClearError) {
 
 TEST(Cli, MalformedNffNamesFileAndLine) {
     fs::path scene = write("broken.nff", "s 0 0 0 1\ns 1 2 nan 1\n");
-    Run r = run("info " + scene.string());
+    CliRun r = run("info " + scene.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find(scene.string() + ":2:"), std::string::npos) << r.err;
     fs::path trunc = write("trunc.nff", "p 4\n0 0 0\n1 0 0\n");
-    Run t = run("info " + trunc.string());
+    CliRun t = run("info " + trunc.string());
     EXPECT_EQ(t.code, 2);
     EXPECT_NE(t.err.find(trunc.string()), std::string::npos) << t.err;
 }
 
 TEST(Cli, EmptySceneIsAClearError) {
     fs::path scene = write("empty.nff", "# nothing here\nb 0 0 0\n");
-    Run r = run("info " + scene.string());
+    CliRun r = run("info " + scene.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("no primitives"), std::string::npos) << r.err;
 }
 
 TEST(Cli, UnknownOptionsHierarchiesAndParametersExitTwo) {
-    Run a = run("trace builtin:tetra:2 --frobnicate");
+    CliRun a = run("trace builtin:tetra:2 --frobnicate");
     EXPECT_EQ(a.code, 2);
     EXPECT_NE(a.err.find("frobnicate"), std::string::npos) << a.err;
-    Run b = run("trace builtin:tetra:2 --hierarchy nope");
+    CliRun b = run("trace builtin:tetra:2 --hierarchy nope");
     EXPECT_EQ(b.code, 2);
     EXPECT_NE(b.err.find("unknown hierarchy 'nope'"), std::string::npos) << b.err;
-    Run c = run("build builtin:tetra:2 --hierarchy bvh-sah --set max_prims=-4");
+    CliRun c = run("build builtin:tetra:2 --hierarchy bvh-sah --set max_prims=-4");
     EXPECT_EQ(c.code, 2);
     EXPECT_NE(c.err.find("max_prims"), std::string::npos) << c.err;
-    Run d = run("frobnicate");
+    CliRun d = run("frobnicate");
     EXPECT_EQ(d.code, 2);
-    Run e = run("info builtin:nosuchscene");
+    CliRun e = run("info builtin:nosuchscene");
     EXPECT_EQ(e.code, 2);
     EXPECT_NE(e.err.find("nosuchscene"), std::string::npos) << e.err;
 }
 
 TEST(Cli, DegeneratePrimitivesAreReportedAndSkipped) {
     fs::path scene = write("degen.nff", "s 0 0 0 0\ns 0 0 0 1\np 3\n0 0 0\n1 1 1\n2 2 2\n");
-    Run r = run("info " + scene.string() + " --json");
+    CliRun r = run("info " + scene.string() + " --json");
     ASSERT_EQ(r.code, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["primitives"], 1);
     EXPECT_EQ(j["warnings"], 2);
-    Run t = run("info " + scene.string());
+    CliRun t = run("info " + scene.string());
     EXPECT_NE(t.err.find(scene.string() + ":1:"), std::string::npos) << t.err;
 }
 
 TEST(Cli, BuildPrintsStructure) {
-    Run r = run("build builtin:tetra:3 -H bvh-median --set max_prims=1 --json");
+    CliRun r = run("build builtin:tetra:3 -H bvh-median --set max_prims=1 --json");
     ASSERT_EQ(r.code, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["build"]["N_V"], 64);
@@ -211,7 +211,7 @@ TEST(Cli, BuildPrintsStructure) {
 }
 
 TEST(Cli, QuietAndPipedOutputHasNoProgressNoise) {
-    Run r = run("trace builtin:tetra:3 -H bvh-sah --rays camera --size 32x32");
+    CliRun r = run("trace builtin:tetra:3 -H bvh-sah --rays camera --size 32x32");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(r.err, "");  // stderr is not a terminal here: no progress drawn
     EXPECT_NE(r.out.find("1024"), std::string::npos);

@@ -85,14 +85,20 @@ inline std::vector<Hit> closest_hits(const Hierarchy& h, std::span<const Ray> ra
 }
 
 /// Counts rays where `got` disagrees with `want`: hit/miss differ, or t differs by more than
-/// `rel_tol` relative (0: exactly). A different primitive at the same t (a shared edge) agrees.
+/// `rel_tol` relative. With rel_tol 0 the same primitive must come with exactly the same t, and a
+/// different primitive is accepted only as a tie (a ray through a shared edge or vertex meets
+/// several primitives at the same point, whose t each primitive's arithmetic rounds a little
+/// differently): within 1e-6 relative.
+/// `abs_tol` adds an absolute floor for hits very near the origin, where float peers round
+/// differently in absolute terms (t ~ 1e-5 from a ray starting on a surface).
 inline std::size_t count_mismatches(std::span<const Hit> want, std::span<const Hit> got, float rel_tol,
-                                    std::string* first = nullptr) {
+                                    std::string* first = nullptr, float abs_tol = 0) {
     std::size_t bad = 0;
     for (std::size_t i = 0; i < want.size(); ++i) {
         bool ok = want[i].hit() == got[i].hit();
         if (ok && want[i].hit()) {
-            float tol = rel_tol * std::fabs(want[i].t);
+            float tol = rel_tol * std::fabs(want[i].t) + abs_tol;
+            if (rel_tol == 0 && want[i].prim != got[i].prim) tol = 1e-6f * std::fabs(want[i].t);
             ok = std::fabs(want[i].t - got[i].t) <= tol;
         }
         if (!ok && bad++ == 0 && first) {
