@@ -11,55 +11,12 @@
 namespace rtcost::test {
 namespace {
 
-struct Measured {
-    double mean = 0, se = 0;  // scalar cost per ray and its standard error
-    CostVector by_kind;
-};
-
-Measured measure_all(const Hierarchy& h, std::span<const Ray> rays, const UnitCosts& costs, Query q) {
-    Measured m;
-    RayCounters total;
-    double sum = 0, sum2 = 0;
-    for (const Ray& r : rays) {
-        RayCounters c;
-        Hit hit;
-        if (q == Query::All) h.all(r, hit, c);
-        else h.closest(r, hit, c);
-        double v = costs.scalar(measured_cost(c));
-        sum += v;
-        sum2 += v * v;
-        total += c;
-    }
-    double n = static_cast<double>(rays.size());
-    m.mean = sum / n;
-    m.se = std::sqrt(std::max(0.0, sum2 / n - m.mean * m.mean) / n);
-    m.by_kind = measured_cost(total);
-    return m;
-}
-
-void expect_exact(const Scene& s, const std::string& name, const std::vector<std::string>& set = {}) {
-    auto h = build_hierarchy(s, name, set);
-    ModelTree t = h->model_tree();
-    ASSERT_FALSE(t.nodes.empty()) << name;
-    ModelOptions opt;
-    opt.query = Query::All;
-    Prediction p = predict_geometric(t, s, opt);
-    auto lines = line_rays(s.bounds(), 200000, 11);
-    Measured m = measure_all(*h, lines, UnitCosts{}, Query::All);
-    EXPECT_NEAR(p.scalar, m.mean, 3 * m.se + 1e-9) << name << " predicted " << p.scalar << " measured " << m.mean
-                                                   << " se " << m.se;
-    // Kind by kind too (same standard error bound is loose but real: kinds are parts of the sum).
-    EXPECT_NEAR(p.cost.box, m.by_kind.box, 3 * m.se + 1e-9) << name;
-    EXPECT_NEAR(p.cost.prim_tests(), m.by_kind.prim_tests(), 3 * m.se + 1e-9) << name;
-    EXPECT_NEAR(p.cost.steps, m.by_kind.steps, 3 * m.se + 1e-9) << name;
-}
-
 TEST(ModelExactness, BvhFamilyOnBuiltinScenes) {
     Scene balls = builtin_scene("balls", 2);
     Scene tetra = builtin_scene("tetra", 4);
     for (const char* name : {"bvh-median", "bvh-gs", "bvh-sah"}) {
-        expect_exact(balls, name);
-        expect_exact(tetra, name);
+        expect_model_exact(balls, name);
+        expect_model_exact(tetra, name);
     }
 }
 

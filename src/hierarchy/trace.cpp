@@ -66,4 +66,34 @@ TraceResult trace_rays(const Hierarchy& h, std::span<const Ray> rays, const Trac
     return res;
 }
 
+TraceResult trace_ray_set(const Hierarchy& h, const RaySet& set, const TraceOptions& opt, Query occlusion) {
+    TraceResult res;
+    res.hits.assign(set.rays.size(), Hit{});
+    res.threads = opt.threads > 0 ? opt.threads : default_threads();
+    // One batch per kind, so each batch runs one query and its counters stay apart.
+    std::array<std::vector<std::size_t>, kRayKinds> index;
+    for (std::size_t i = 0; i < set.rays.size(); ++i) index[static_cast<int>(set.kinds[i])].push_back(i);
+    std::size_t before = 0;
+    for (int k = 0; k < kRayKinds; ++k) {
+        if (index[k].empty()) continue;
+        std::vector<Ray> batch;
+        batch.reserve(index[k].size());
+        for (std::size_t i : index[k]) batch.push_back(set.rays[i]);
+        TraceOptions o = opt;
+        RayKind kind = static_cast<RayKind>(k);
+        if (kind == RayKind::Shadow || kind == RayKind::AO) o.query = occlusion;
+        if (opt.progress) o.progress = [&](std::size_t d) { opt.progress(before + d); };
+        TraceResult r = trace_rays(h, batch, o);
+        for (std::size_t j = 0; j < batch.size(); ++j) res.hits[index[k][j]] = r.hits[j];
+        res.seconds += r.seconds;
+        res.hit_count += r.hit_count;
+        res.counters += r.counters;
+        res.rays_by_kind[k] = batch.size();
+        res.hits_by_kind[k] = r.hit_count;
+        res.counters_by_kind[k] = r.counters;
+        before += batch.size();
+    }
+    return res;
+}
+
 }  // namespace rtcost

@@ -1,0 +1,67 @@
+#pragma once
+// Shared pieces of the rtcost command line: common flags, scene loading, building, ray options,
+// and the registry through which each subcommand's file adds itself to the app.
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "rtcost/error.hpp"
+#include "rtcost/hierarchy.hpp"
+#include "rtcost/io.hpp"
+#include "rtcost/rays.hpp"
+#include "rtcost/report.hpp"
+#include "rtcost/trace.hpp"
+
+namespace rtcost::cli {
+
+inline constexpr int kExitBadInput = 2;
+
+struct Common {
+    bool json = false;
+    bool quiet = false;
+};
+
+/// Adds --json (unless `with_json` is false) and --quiet to `cmd`.
+void add_common(CLI::App* cmd, Common& common, bool with_json = true);
+
+/// Loads a scene (path or builtin:NAME[:level]) and prints its warnings unless quiet or JSON.
+Scene load(const std::string& spec, const Common& common);
+
+/// "7381 spheres, 1 polygon".
+std::string kind_summary(const Scene& s);
+
+/// Text listing of every hierarchy and its parameters with defaults; shown by `--help`.
+std::string hierarchy_help();
+
+struct BuildArgs {
+    std::string scene;
+    std::string hierarchy = "brute";
+    std::vector<std::string> set;
+};
+void add_build_args(CLI::App* cmd, BuildArgs& a);
+/// Builds with a note on a terminal while it runs.
+std::unique_ptr<Hierarchy> build(const Scene& scene, const BuildArgs& a, const Common& common);
+
+/// --rays, --size, --count, --seed into `spec`.
+void add_ray_args(CLI::App* cmd, RaySpec& spec);
+
+/// Parses --query.
+Query parse_query(const std::string& q);
+
+/// A subcommand: the CLI11 app it added, and what runs when it is chosen.
+struct Subcommand {
+    CLI::App* app = nullptr;
+    std::function<int()> run;
+};
+using CommandSetup = Subcommand (*)(CLI::App& parent, Common& common);
+
+/// Each subcommand's file registers itself; `order` sorts them in `--help`.
+struct CommandRegistration {
+    CommandRegistration(int order, CommandSetup setup);
+};
+std::vector<std::pair<int, CommandSetup>>& command_registry();
+
+}  // namespace rtcost::cli

@@ -1,0 +1,92 @@
+// Shared pieces of the command line (see cli.hpp).
+#include "cli.hpp"
+
+#include <cstdio>
+#include <unistd.h>
+
+namespace rtcost::cli {
+
+std::vector<std::pair<int, CommandSetup>>& command_registry() {
+    static std::vector<std::pair<int, CommandSetup>> registry;
+    return registry;
+}
+
+CommandRegistration::CommandRegistration(int order, CommandSetup setup) {
+    command_registry().emplace_back(order, setup);
+}
+
+void add_common(CLI::App* cmd, Common& common, bool with_json) {
+    if (with_json) cmd->add_flag("--json", common.json, "machine-readable JSON on stdout");
+    cmd->add_flag("-q,--quiet", common.quiet, "no progress and no warnings on stderr");
+}
+
+void add_ray_args(CLI::App* cmd, RaySpec& spec) {
+    std::string names;
+    for (const auto& n : distribution_names()) names += (names.empty() ? "" : ", ") + n;
+    cmd->add_option("-r,--rays", spec.name, "rays: a distribution (" + names + ") or a ray file (8 float32 per ray)")
+        ->capture_default_str();
+    cmd->add_option("--size", spec.size, "image size WxH for camera-based rays (default: the scene's)");
+    cmd->add_option("--count", spec.count, "number of rays for lines and random")->capture_default_str();
+    cmd->add_option("--seed", spec.seed, "seed for random distributions")->capture_default_str();
+}
+
+Query parse_query(const std::string& q) { return q == "any" ? Query::Any : q == "all" ? Query::All : Query::Closest; }
+
+namespace {
+/// Warnings gathered while loading (degenerate primitives skipped), to stderr unless quiet.
+void print_warnings(const Scene& scene, bool quiet) {
+    if (quiet || scene.warnings.empty()) return;
+    constexpr std::size_t kShown = 5;
+    for (std::size_t i = 0; i < scene.warnings.size() && i < kShown; ++i)
+        fmt::print(stderr, "rtcost: warning: {}\n", scene.warnings[i]);
+    if (scene.warnings.size() > kShown)
+        fmt::print(stderr, "rtcost: warning: ... and {} more\n", scene.warnings.size() - kShown);
+}
+}  // namespace
+
+Scene load(const std::string& spec, const Common& common) {
+    Scene scene = load_scene(spec);
+    print_warnings(scene, common.quiet || common.json);
+    return scene;
+}
+
+std::string kind_summary(const Scene& s) {
+    std::string out;
+    auto counts = s.kind_counts();
+    for (int k = 0; k < kPrimKinds; ++k) {
+        if (!counts[k]) continue;
+        out += fmt::format("{}{} {}{}", out.empty() ? "" : ", ", counts[k],
+                           prim_kind_name(static_cast<PrimKind>(k)), counts[k] == 1 ? "" : "s");
+    }
+    return out;
+}
+
+std::string hierarchy_help() {
+    std::string out = "Hierarchies (--hierarchy NAME, parameters with --set key=value):\n";
+    for (const HierarchyInfo* h : hierarchies()) {
+        out += fmt::format("  {:<12} {}\n", h->name, h->description);
+        for (const ParamSpec& p : h->params)
+            out += fmt::format("      {:<22} {}\n", p.name + "=" + p.default_value, p.help);
+    }
+    return out;
+}
+
+void add_build_args(CLI::App* cmd, BuildArgs& a) {
+    cmd->add_option("SCENE", a.scene, "scene file (.nff, or any mesh assimp reads) or builtin:NAME[:level]")
+        ->required();
+    cmd->add_option("-H,--hierarchy", a.hierarchy, "hierarchy to build (see the list below)")
+        ->capture_default_str();
+    cmd->add_option("--set", a.set, "hierarchy parameter key=value (repeatable)");
+}
+
+std::unique_ptr<Hierarchy> build(const Scene& scene, const BuildArgs& a, const Common& common) {
+    // A build reports no fraction done, so the terminal shows what is being built while it runs.
+    bool tty = !common.quiet && ::isatty(STDERR_FILENO);
+    if (tty) fmt::print(stderr, "building {} over {} primitives...", a.hierarchy, scene.size());
+    std::fflush(stderr);
+    auto h = build_hierarchy(scene, a.hierarchy, a.set);
+    if (tty) fmt::print(stderr, "\r\033[K");
+    return h;
+}
+
+}  // namespace rtcost::cli
