@@ -155,6 +155,14 @@ int cmd_eval(EvalArgs& a, const Common& common) {
         auto h = build(scene, BuildArgs{a.scene, name, a.set}, common);
         EvalRow row;
         row.name = name;
+        TraceOptions opt;
+        opt.query = mo.query;
+        opt.threads = a.threads;
+        TraceResult timed = trace_ray_set(*h, test, opt, occlusion);
+        opt.count = true;
+        TraceResult counted = trace_ray_set(*h, test, opt, occlusion);
+        // Structure and model tree after tracing: a lazily built hierarchy (rc5d) exists only
+        // where rays went.
         row.s = h->structure();
         ModelTree tree = h->model_tree();
         row.modelled = !tree.nodes.empty();
@@ -178,12 +186,6 @@ int cmd_eval(EvalArgs& a, const Common& common) {
             }
             row.pred = mix(parts, costs);
         }
-        TraceOptions opt;
-        opt.query = mo.query;
-        opt.threads = a.threads;
-        TraceResult timed = trace_ray_set(*h, test, opt, occlusion);
-        opt.count = true;
-        TraceResult counted = trace_ray_set(*h, test, opt, occlusion);
         row.meas = measured_cost(counted.counters);
         row.meas_scalar = costs.scalar(row.meas);
         row.error = row.modelled && row.meas_scalar > 0 ? (row.pred.scalar - row.meas_scalar) / row.meas_scalar : 0;

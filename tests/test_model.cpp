@@ -20,6 +20,41 @@ TEST(ModelExactness, BvhFamilyOnBuiltinScenes) {
     }
 }
 
+TEST(ModelExactness, GridOnBuiltinScenes) {
+    Scene balls = builtin_scene("balls", 2);
+    Scene tetra = builtin_scene("tetra", 4);
+    for (const auto& set : std::vector<std::vector<std::string>>{{}, {"res=woo", "assign=exact"}, {"res=5x3x4"}}) {
+        expect_model_exact(balls, "grid", set);
+        expect_model_exact(tetra, "grid", set);
+    }
+}
+
+TEST(ModelExactness, Rc5dOnBuiltinScenes) {
+    Scene balls = builtin_scene("balls", 2);
+    expect_model_exact(balls, "rc5d", {"build=eager", "max_depth=10"});
+    expect_model_exact(builtin_scene("tetra", 4), "rc5d", {"build=eager", "max_depth=15", "max_prims=4"});
+}
+
+TEST(ModelSampled, Rc5dOrderedSearchOnCameraRays) {
+    // The 5D model follows each ray's one path; the ordered candidate search is where the
+    // sampled estimator earns its keep: trained on half the camera rays, tested on the other.
+    Scene s = builtin_scene("balls", 2);
+    auto h = build_hierarchy(s, "rc5d", {"build=eager", "max_depth=12"});
+    auto rays = camera_rays(s.camera, 128, 128);
+    std::vector<Ray> train, test;
+    for (std::size_t i = 0; i < rays.size(); ++i) (i % 2 ? train : test).push_back(rays[i]);
+    auto hits = trace_rays(*h, train).hits;
+    ModelOptions closest;
+    Prediction ps = predict_sampled(h->model_tree(), s, train, hits, closest);
+    Measured m = measure_all(*h, test, UnitCosts{}, Query::Closest);
+    EXPECT_NEAR(ps.scalar, m.mean, 0.05 * m.mean) << "sampled " << ps.scalar << " measured " << m.mean;
+    EXPECT_NEAR(ps.cost.classify, m.by_kind.classify, 0.05 * m.by_kind.classify);
+    // Without termination every candidate counts, so closest hits cost less.
+    ModelOptions all;
+    all.query = Query::All;
+    EXPECT_LT(ps.scalar, predict_sampled(h->model_tree(), s, train, hits, all).scalar);
+}
+
 TEST(ModelExactness, BruteForceIsEveryPrimitive) {
     Scene s = builtin_scene("tetra", 3);
     auto h = build_hierarchy(s, "brute");

@@ -45,6 +45,14 @@ struct ModelNode {
     /// first carries the visit, the other two none).
     float box = 0, plane = 0, hop = 0, classify = 0;
     bool step = true;            ///< a visit is one traversal step (N_TS)
+    /// 5D ray classification: the node is a set of rays, `region` its origin box and these its
+    /// directions: dominant axis `beam_axis` (-1: not a beam) and sign, u and v ranges (the other
+    /// two direction components over |d[beam_axis]|, lower axis first). Children split one of
+    /// the five dimensions at `split`: `beam_dim` 0..2 origin, 3 u, 4 v.
+    std::int8_t beam_axis = -1;
+    bool beam_negative = false;
+    std::int8_t beam_dim = -1;
+    float beam_u[2] = {-1, 1}, beam_v[2] = {-1, 1};
 };
 
 /// A hierarchy flattened for the model: `nodes[0]` is the root; the children of a node are
@@ -58,6 +66,10 @@ struct ModelTree {
     /// Operations every ray pays once whatever it meets (e.g. the root box test), and those a
     /// ray that enters the root pays once more or less (a grid's first cell has no hop: -1).
     float per_ray_box = 1, per_entry_hop = 0;
+    /// A ray follows exactly one root-to-leaf path (5D classification: the children of a node
+    /// are disjoint sets of rays), whose leaf candidates are searched in order of their start
+    /// along the dominant axis and the search stops early.
+    bool one_path = false;
     std::vector<ModelNode> nodes;
     std::vector<std::uint32_t> prims;  ///< leaf primitive references
 };

@@ -65,6 +65,10 @@ struct NodeProbabilities {
     double both = 0;
     double p_hit = 0;   ///< P: the segment handed to the node hits inside its region
     double p_bv = 1;    ///< the segment meets the node's bounding volume (when it has one)
+    /// Leaves of one-path trees (5D) searched in order: expected candidates tested per visit, by
+    /// kind, when the search may stop early.
+    bool ordered = false;
+    std::array<double, kPrimKinds> tests{};
 };
 
 /// A prediction: the cost vector, its scalar, and visit probabilities per model depth.

@@ -188,8 +188,12 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
         if (m.leaf) {
             c.leaves += p;
             if (m.count == 0) c.empty_leaves += p;
-            for (std::uint32_t k = 0; k < m.count; ++k)
-                c.prim[static_cast<int>(scene.kind(t.prims[m.first + k]))] += pg;
+            if (terminate && q.ordered) {
+                for (int k = 0; k < kPrimKinds; ++k) c.prim[k] += pg * q.tests[k];
+            } else {
+                for (std::uint32_t k = 0; k < m.count; ++k)
+                    c.prim[static_cast<int>(scene.kind(t.prims[m.first + k]))] += pg;
+            }
             if (t.locate) {
                 // Every cell is found by a descent from the root: its ancestors' work again.
                 for (int a = w.parent[i]; a >= 0; a = w.parent[a]) {
@@ -204,7 +208,10 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
             continue;
         }
         // Children's conditional visit probabilities.
-        if (q.split) {
+        if (t.one_path) {
+            // Disjoint sets of rays: each ray goes to exactly one child, no sibling can stop it.
+            for (std::uint32_t k = 0; k < m.count; ++k) pi[m.first + k] = pg * prob[m.first + k].handed;
+        } else if (q.split) {
             const std::uint32_t b = m.first, cc = m.first + 1;
             const double both = q.both;
             const double pb = terminate ? prob[b].p_hit : 0.0, pc = terminate ? prob[cc].p_hit : 0.0;
@@ -270,11 +277,199 @@ std::vector<double> area_inside(const ModelTree& t, const Walk& w, const Scene& 
     return a;
 }
 
+
+// ---- 5D ray classification under the line measure ----------------------------------------
+// A line entering the root box B through face f at a point x with direction w has density
+// |w . n_f| dA dw (the invariant measure of lines). A beam is a set of (entry point, direction):
+// its weight is the sum over the faces of B it touches of area(face within its origin box) times
+// the integral over its directions entering that face of |w . n_f|. With w = (s e_k + u e_i1 +
+// v e_i2) / r, r = sqrt(1 + u^2 + v^2), dw = du dv / r^3, the integrand is |component| / r^4.
+// Integrated by Gauss-Legendre quadrature (the integrands are smooth once split at 0).
+
+double gauss_2d(double u0, double u1, double v0, double v1, int which, double sign) {
+    static constexpr double x[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290,
+                                    -0.1834346424956498, 0.1834346424956498,  0.5255324099163290,
+                                    0.7966664774136267,  0.9602898564975363};
+    static constexpr double w[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873,
+                                    0.3626837833783620, 0.3626837833783620, 0.3137066458778873,
+                                    0.2223810344533745, 0.1012285362903763};
+    // which: 0 = constant component (the dominant axis), 1 = u, 2 = v; only where sign*comp > 0.
+    auto part = [&](double a0, double a1, double b0, double b1) {
+        if (!(a1 > a0) || !(b1 > b0)) return 0.0;
+        double hu = 0.5 * (a1 - a0), cu = 0.5 * (a1 + a0), hv = 0.5 * (b1 - b0), cv = 0.5 * (b1 + b0);
+        double sum = 0;
+        for (int i = 0; i < 8; ++i) {
+            double u = cu + hu * x[i];
+            for (int j = 0; j < 8; ++j) {
+                double v = cv + hv * x[j];
+                double r2 = 1 + u * u + v * v;
+                double comp = which == 0 ? 1.0 : which == 1 ? sign * u : sign * v;
+                sum += w[i] * w[j] * std::max(0.0, comp) / (r2 * r2);
+            }
+        }
+        return sum * hu * hv;
+    };
+    // Split at 0 on the axis whose component changes sign, so each piece is smooth.
+    if (which == 1 && u0 < 0 && u1 > 0) return part(u0, 0, v0, v1) + part(0, u1, v0, v1);
+    if (which == 2 && v0 < 0 && v1 > 0) return part(u0, u1, v0, 0) + part(u0, u1, 0, v1);
+    return part(u0, u1, v0, v1);
+}
+
+/// Line-measure weight of a beam whose origins lie in `o` (inside root box `b`).
+double beam_weight(const ModelNode& m, const Box3& b) {
+    const int k = m.beam_axis;
+    const int i1 = k == 0 ? 1 : 0;  // the other axis carries v
+    const double s = m.beam_negative ? -1.0 : 1.0;
+    const Box3& o = m.region;
+    double total = 0;
+    for (int a = 0; a < 3; ++a) {
+        const int p = (a + 1) % 3, q = (a + 2) % 3;
+        const double area = (double(o.hi[p]) - o.lo[p]) * (double(o.hi[q]) - o.lo[q]);
+        for (int side = 0; side < 2; ++side) {
+            // side 0: the low face (outward normal -e_a): entering needs w_a > 0.
+            const bool touches = side == 0 ? o.lo[a] <= b.lo[a] : o.hi[a] >= b.hi[a];
+            if (!touches || area <= 0) continue;
+            const double dir = side == 0 ? 1.0 : -1.0;
+            double integral;
+            if (a == k) integral = s * dir > 0 ? gauss_2d(m.beam_u[0], m.beam_u[1], m.beam_v[0], m.beam_v[1], 0, 1) : 0;
+            else if (a == i1) integral = gauss_2d(m.beam_u[0], m.beam_u[1], m.beam_v[0], m.beam_v[1], 1, dir);
+            else integral = gauss_2d(m.beam_u[0], m.beam_u[1], m.beam_v[0], m.beam_v[1], 2, dir);
+            total += area * integral;
+        }
+    }
+    return total;
+}
+
+/// Forward start of a primitive along a beam's dominant axis (its bounding box's near face).
+double forward_start(const Box3& pb, int k, bool negative) { return negative ? -double(pb.hi[k]) : double(pb.lo[k]); }
+
+Prediction predict_one_path_geometric(const ModelTree& t, const Walk& w, const Scene& scene, const ModelOptions& opt,
+                                      const UnitCosts& costs) {
+    const std::size_t n = t.nodes.size();
+    std::vector<NodeProbabilities> prob(n);
+    std::vector<double> weight(n, 0.0);
+    const Box3& root = t.nodes[0].region;
+    for (std::size_t i = n; i-- > 1;) {
+        const ModelNode& m = t.nodes[i];
+        if (m.leaf) weight[i] = beam_weight(m, root);
+        else
+            for (std::uint32_t k = 0; k < m.count; ++k) weight[i] += weight[m.first + k];
+    }
+    for (std::uint32_t k = 0; k < t.nodes[0].count; ++k) weight[0] += weight[t.nodes[0].first + k];
+    for (std::size_t i = 0; i < n; ++i) {
+        const ModelNode& m = t.nodes[i];
+        if (m.leaf) {
+            // Ordered search: candidate j is tested unless an earlier one ended the search; each
+            // earlier candidate is hit with p = its Crofton area over the surface of the box
+            // around the leaf's candidates (an approximation: independence, no occlusion order).
+            Box3 around;
+            for (std::uint32_t k = 0; k < m.count; ++k) around.extend(scene.prim_bounds(t.prims[m.first + k]));
+            double sa = surface(around);
+            double alive = 1;
+            prob[i].ordered = true;
+            for (std::uint32_t k = 0; k < m.count; ++k) {
+                std::uint32_t id = t.prims[m.first + k];
+                prob[i].tests[static_cast<int>(scene.kind(id))] += alive;
+                double p = sa > 0 ? std::min(1.0, crofton_area(scene, id) / sa) : 0.0;
+                alive *= 1 - p;
+            }
+            continue;
+        }
+        for (std::uint32_t k = 0; k < m.count; ++k)
+            prob[m.first + k].handed = weight[i] > 0 ? weight[m.first + k] / weight[i] : 0.0;
+    }
+    Prediction p = evaluate(t, w, prob, scene, opt, costs);
+    p.estimator = "geometric";
+    p.note = "5D beams: probability of each beam under the line measure by numerical integration; ordered "
+             "candidates: P(search reaches j) = prod over earlier candidates of (1 - Crofton area / area of "
+             "the box around the leaf's candidates)";
+    return p;
+}
+
+Prediction predict_one_path_sampled(const ModelTree& t, const Walk& w, const Scene& scene,
+                                    std::span<const Ray> training, std::span<const Hit> closest,
+                                    const ModelOptions& opt, const UnitCosts& costs) {
+    const std::size_t n = t.nodes.size();
+    std::vector<double> handed(n, 0.0);
+    std::vector<std::array<double, kPrimKinds>> tests(n, std::array<double, kPrimKinds>{});
+    const Box3& root = t.nodes[0].region;
+    const bool terminate = opt.query != Query::All;
+    std::size_t met = 0;
+    for (std::size_t r = 0; r < training.size(); ++r) {
+        const Ray& ray = training[r];
+        const RayInv ri(ray);
+        if (box_entry(root, ri.o, ri.inv, ray.tmin, ray.tmax) == kInf) continue;
+        const int k = max_axis(ray.d);
+        const double adk = std::fabs(double(ray.d[k]));
+        if (!(adk > 0)) continue;
+        ++met;
+        // The classification point: the ray's point at max(tmin, box entry), clamped to the box.
+        double t0 = ray.tmin;
+        for (int a = 0; a < 3; ++a) {
+            if (ray.d[a] == 0) continue;
+            double bound = ray.d[a] > 0 ? root.lo[a] : root.hi[a];
+            t0 = std::max(t0, (bound - double(ray.o[a])) / double(ray.d[a]));
+        }
+        double x[5];
+        for (int a = 0; a < 3; ++a)
+            x[a] = std::clamp(double(ray.o[a]) + (ray.d[a] != 0 ? t0 * double(ray.d[a]) : 0.0), double(root.lo[a]),
+                              double(root.hi[a]));
+        const int i1 = k == 0 ? 1 : 0, i2 = k == 2 ? 1 : 2;
+        x[3] = float(ray.d[i1] / float(adk));
+        x[4] = float(ray.d[i2] / float(adk));
+        const bool neg = ray.d[k] < 0;
+        std::uint32_t node = 0;
+        handed[0] += 1;
+        node = t.nodes[0].first + static_cast<std::uint32_t>(2 * k + (neg ? 1 : 0));
+        for (;;) {
+            handed[node] += 1;
+            const ModelNode& m = t.nodes[node];
+            if (m.leaf) break;
+            node = m.first + (float(x[m.beam_dim]) >= m.split ? 1u : 0u);
+        }
+        const ModelNode& leaf = t.nodes[node];
+        const double so = neg ? -double(ray.o[k]) : double(ray.o[k]);
+        const double stop = closest[r].hit() && terminate ? so + double(closest[r].t) * adk : kInf;
+        for (std::uint32_t c = 0; c < leaf.count; ++c) {
+            std::uint32_t id = t.prims[leaf.first + c];
+            if (forward_start(scene.prim_bounds(id), k, neg) > stop) break;
+            tests[node][static_cast<int>(scene.kind(id))] += 1;
+        }
+    }
+    std::vector<NodeProbabilities> prob(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        const ModelNode& m = t.nodes[i];
+        if (m.leaf) {
+            prob[i].ordered = true;
+            for (int k = 0; k < kPrimKinds; ++k) prob[i].tests[k] = handed[i] > 0 ? tests[i][k] / handed[i] : 0.0;
+            continue;
+        }
+        for (std::uint32_t k = 0; k < m.count; ++k)
+            prob[m.first + k].handed = handed[i] > 0 ? handed[m.first + k] / handed[i] : 0.0;
+    }
+    Prediction p = evaluate(t, w, prob, scene, opt, costs);
+    p.estimator = "sampled";
+    p.note = "5D: path probabilities and ordered-search lengths from " + std::to_string(training.size()) +
+             " training rays";
+    double share = training.empty() ? 0.0 : double(met) / double(training.size());
+    CostVector& c = p.cost;
+    c.box -= t.per_ray_box;
+    auto scale = [&](double& v) { v *= share; };
+    scale(c.box); scale(c.plane); scale(c.hop); scale(c.classify);
+    for (auto& v : c.prim) scale(v);
+    scale(c.steps); scale(c.leaves); scale(c.empty_leaves);
+    for (auto& v : p.visits_by_depth) scale(v);
+    c.box += t.per_ray_box;
+    p.scalar = costs.scalar(c);
+    return p;
+}
+
 }  // namespace
 
 Prediction predict_geometric(const ModelTree& t, const Scene& scene, const ModelOptions& opt, const UnitCosts& costs) {
     if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
     Walk w(t);
+    if (t.one_path) return predict_one_path_geometric(t, w, scene, opt, costs);
     const std::size_t n = t.nodes.size();
     std::vector<NodeProbabilities> prob(n);
     std::vector<double> inside = area_inside(t, w, scene);
@@ -310,6 +505,7 @@ Prediction predict_sampled(const ModelTree& t, const Scene& scene, std::span<con
                            std::span<const Hit> closest, const ModelOptions& opt, const UnitCosts& costs) {
     if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
     Walk w(t);
+    if (t.one_path) return predict_one_path_sampled(t, w, scene, training, closest, opt, costs);
     const std::size_t n = t.nodes.size();
     // Per-node tallies of the probe walk.
     struct Tally {

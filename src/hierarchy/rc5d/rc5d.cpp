@@ -215,6 +215,7 @@ ModelTree Rc5d::model_tree() const {
     t.family = "rc5d";
     t.per_ray_box = 1;
     t.per_entry_hop = 0;
+    t.one_path = true;
     ModelNode root;
     root.region = box_;
     root.leaf = false;
@@ -228,11 +229,13 @@ ModelTree Rc5d::model_tree() const {
         int level;
     };
     std::vector<Item> work;  // work[i] describes t.nodes[i + 1]
-    for (const Node& c : cubes_) {
-        work.push_back({&c, root_, 0});
+    for (int c = 0; c < 6; ++c) {
+        work.push_back({&cubes_[c], root_, 0});
         ModelNode m;
         m.region = root_.origin_box();
         m.depth = 1;
+        m.beam_axis = static_cast<std::int8_t>(c / 2);
+        m.beam_negative = c % 2 == 1;
         t.nodes.push_back(m);
     }
     for (std::size_t w = 0; w < work.size(); ++w) {
@@ -244,13 +247,22 @@ ModelTree Rc5d::model_tree() const {
             t.nodes[idx].classify = 1;
             t.nodes[idx].first = static_cast<std::uint32_t>(t.nodes.size());
             t.nodes[idx].count = 2;
+            t.nodes[idx].beam_dim = static_cast<std::int8_t>(dim);
+            t.nodes[idx].split = it.n->split;
             const int depth = t.nodes[idx].depth;
+            const ModelNode parent = t.nodes[idx];
             for (int side = 0; side < 2; ++side) {
                 Cell c = child_cell(it.cell, dim, it.n->split, side);
                 work.push_back({&it.n->kids[side], c, it.level + 1});
                 ModelNode m;
                 m.region = c.origin_box();
                 m.depth = depth + 1;
+                m.beam_axis = parent.beam_axis;
+                m.beam_negative = parent.beam_negative;
+                m.beam_u[0] = c.lo[3];
+                m.beam_u[1] = c.hi[3];
+                m.beam_v[0] = c.lo[4];
+                m.beam_v[1] = c.hi[4];
                 t.nodes.push_back(m);
             }
         } else {
