@@ -67,6 +67,9 @@ struct EvalRow {
     CostVector meas;
     std::vector<double> meas_visits;
     double meas_scalar = 0, error = 0, mrays = 0;
+    double ns_per_ray = 0;  // measured wall time per ray x threads
+    int threads = 1;
+    bool lazy = false;
     int rank_pred = 0, rank_meas = 0;
 };
 
@@ -157,13 +160,19 @@ int cmd_eval(EvalArgs& a, const Common& common) {
         row.name = name;
         TraceOptions opt;
         opt.query = mo.query;
-        opt.threads = a.threads;
-        TraceResult timed = trace_ray_set(*h, test, opt, occlusion);
+        // With calibrated (single-thread) unit costs, time on one thread unless told otherwise.
+        opt.threads = a.threads > 0 ? a.threads : costs.calibrated ? 1 : 0;
+        // Counted first, so a lazily built hierarchy (rc5d) is complete when timed.
         opt.count = true;
         TraceResult counted = trace_ray_set(*h, test, opt, occlusion);
+        opt.count = false;
+        TraceResult timed = trace_ray_set(*h, test, opt, occlusion);
         // Structure and model tree after tracing: a lazily built hierarchy (rc5d) exists only
-        // where rays went.
+        // where rays went, so the training rays go through it too.
+        if (sampled && h->lazy())
+            for (int k = 0; k < kRayKinds; ++k) trace_rays(*h, train_kinds[k]);
         row.s = h->structure();
+        row.lazy = h->lazy();
         ModelTree tree = h->model_tree();
         row.modelled = !tree.nodes.empty();
         if (row.modelled) {
@@ -190,6 +199,8 @@ int cmd_eval(EvalArgs& a, const Common& common) {
         row.meas_scalar = costs.scalar(row.meas);
         row.error = row.modelled && row.meas_scalar > 0 ? (row.pred.scalar - row.meas_scalar) / row.meas_scalar : 0;
         row.mrays = timed.seconds > 0 ? test.rays.size() / timed.seconds / 1e6 : 0;
+        row.ns_per_ray = test.rays.empty() ? 0 : timed.seconds * 1e9 * timed.threads / test.rays.size();
+        row.threads = timed.threads;
         double n = counted.counters.rays ? static_cast<double>(counted.counters.rays) : 1;
         for (int d = 0; d < kMaxStatDepth; ++d) row.meas_visits.push_back(counted.counters.visits[d] / n);
         while (!row.meas_visits.empty() && row.meas_visits.back() == 0) row.meas_visits.pop_back();
@@ -204,12 +215,14 @@ int cmd_eval(EvalArgs& a, const Common& common) {
         json results = json::array();
         for (const auto& r : rows) {
             json j = {{"hierarchy", r.name}, {"build", to_json(r.s)}, {"measured", cost_json(r.meas, r.meas_scalar)},
-                      {"mrays_per_s", r.mrays}, {"rank_measured", r.rank_meas}};
+                      {"mrays_per_s", r.mrays}, {"rank_measured", r.rank_meas},
+                      {"time", {{"measured_ns_per_ray", r.ns_per_ray}, {"threads", r.threads}}}};
+            if (costs.calibrated && r.modelled) j["time"]["predicted_ns_per_ray"] = r.pred.scalar;
             if (r.modelled) {
                 j["predicted"] = cost_json(r.pred.cost, r.pred.scalar);
                 j["error"] = r.error;
                 j["rank_predicted"] = r.rank_pred;
-                j["note"] = r.pred.note;
+                j["note"] = r.pred.note + (r.lazy ? "; lazily built: modelled over the beams built by the rays so far" : "");
             } else {
                 j["predicted"] = nullptr;
             }
@@ -239,6 +252,15 @@ int cmd_eval(EvalArgs& a, const Common& common) {
                    r.modelled ? fmt::format("{:.2f}", r.pred.scalar) : "-", r.meas_scalar,
                    r.modelled ? fmt::format("{:+.1f}%", 100 * r.error) : "-", r.mrays,
                    r.modelled ? std::to_string(r.rank_pred) : "-", r.rank_meas);
+    }
+    if (costs.calibrated) {
+        fmt::print("\ntime per ray (calibrated unit costs; measured on {} thread{}):\n", rows.empty() ? 1 : rows[0].threads,
+                   !rows.empty() && rows[0].threads == 1 ? "" : "s x threads");
+        for (const auto& r : rows) {
+            if (!r.modelled) continue;
+            fmt::print("{:<12} predicted {:10.1f} ns  measured {:10.1f} ns  {:+.1f}%\n", r.name, r.pred.scalar,
+                       r.ns_per_ray, r.ns_per_ray > 0 ? 100 * (r.pred.scalar - r.ns_per_ray) / r.ns_per_ray : 0.0);
+        }
     }
     fmt::print("\nby kind (predicted / measured per ray):\n");
     for (const auto& r : rows) {

@@ -107,6 +107,41 @@ TEST(ModelTermination, ClosestHitCostsLessThanAllHitsAndSampledIsClose) {
     EXPECT_NEAR(psa.scalar, ma.mean, 0.02 * ma.mean);
 }
 
+TEST(Calibrate, RecoversKnownUnitCostsAndKeepsThemNonNegative) {
+    // Synthetic runs timed by known costs: the fit must give them back.
+    UnitCosts truth;
+    truth.box = 3; truth.plane = 0; truth.hop = 7; truth.classify = 2; truth.per_ray = 40;
+    truth.prim = {20, 55, 9, 0};
+    std::vector<CalibrationSample> runs;
+    for (int i = 0; i < 12; ++i) {
+        CalibrationSample s;
+        s.label = "run " + std::to_string(i);
+        s.ops.box = 5 + 3 * i;
+        s.ops.hop = (i % 3) * 4.0;
+        s.ops.classify = (i % 4 == 1) ? 30.0 : 0.0;
+        s.ops.prim = {1.0 + i % 5, (i % 2) * 2.0, 3.0 + (i * 7) % 4, 0};
+        s.ns_per_ray = truth.scalar(s.ops);
+        runs.push_back(s);
+    }
+    Calibration c = calibrate(runs);
+    EXPECT_NEAR(c.costs.box, 3, 1e-6);
+    EXPECT_NEAR(c.costs.hop, 7, 1e-6);
+    EXPECT_NEAR(c.costs.classify, 2, 1e-6);
+    EXPECT_NEAR(c.costs.prim[0], 20, 1e-6);
+    EXPECT_NEAR(c.costs.prim[1], 55, 1e-6);
+    EXPECT_NEAR(c.costs.prim[2], 9, 1e-6);
+    EXPECT_NEAR(c.costs.per_ray, 40, 1e-5);
+    EXPECT_FALSE(c.fitted[1]);  // no run performs a plane compare
+    EXPECT_NEAR(c.rms_relative, 0, 1e-9);
+    // Times that only a negative box cost would fit: the fit stays at zero instead.
+    for (auto& s : runs) s.ns_per_ray = 100 - s.ops.box + 20 * s.ops.prim[0] + 9 * s.ops.prim[2];
+    Calibration n = calibrate(runs);
+    EXPECT_GE(n.costs.box, 0);
+    EXPECT_GT(n.rms_relative, 0);
+    // Fewer runs than unknowns: an error, not a guess.
+    EXPECT_THROW(calibrate(std::span(runs).first(3)), InputError);
+}
+
 TEST(UnitCosts, ReadsACostsFileAndRejectsBadOnes) {
     auto dir = std::filesystem::temp_directory_path();
     auto good = dir / "rtcost_costs_good.json";

@@ -135,6 +135,10 @@ public:
     /// (embree).
     virtual ModelTree model_tree() const { return {}; }
 
+    /// True when the structure grows as rays arrive (Arvo and Kirk's lazy classification):
+    /// structure() and model_tree() then describe only what the rays so far have built.
+    virtual bool lazy() const { return false; }
+
 protected:
     explicit Hierarchy(const Scene& scene) : scene_(&scene) {}
     /// Everything of StructureStats but `seconds`, which build_hierarchy measures.

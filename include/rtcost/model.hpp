@@ -29,12 +29,38 @@ struct CostVector {
 struct UnitCosts {
     double box = 1, plane = 1, hop = 1, classify = 1;
     std::array<double, kPrimKinds> prim{1, 1, 1, 1};
+    double per_ray = 0;       ///< fixed cost of every ray (calibrated files: setup, clip, loop)
     bool calibrated = false;  ///< nanoseconds fitted by `rtcost calibrate`
 
     double scalar(const CostVector& c) const;
-    /// Reads a costs file (JSON `{"box": ns, "plane": ns, ..., "prim": {"triangle": ns, ...}}`).
+    /// Reads a costs file (JSON `{"unit": "ns", "box": ns, "plane": ns, ..., "per_ray": ns,
+    /// "prim": {"triangle": ns, ...}}`).
     static UnitCosts read(const std::string& path);
 };
+
+/// One calibration run: the measured operations per ray and the measured single-thread
+/// nanoseconds per ray of one hierarchy on one ray set.
+struct CalibrationSample {
+    std::string label;  ///< e.g. "bvh-sah on balls"
+    CostVector ops;
+    double ns_per_ray = 0;
+};
+
+struct Calibration {
+    UnitCosts costs;                ///< fitted ns per operation (calibrated = true)
+    std::vector<double> predicted;  ///< fitted ns per ray for each sample
+    std::vector<bool> fitted;       ///< kinds (box, plane, hop, classify, prims..., per_ray) the data determined
+    double rms_relative = 0;        ///< root mean square of (predicted - measured) / measured
+};
+
+/// Non-negative least squares of ns_per_ray = per_ray + sum over kinds of c_kind * ops_kind,
+/// each sample weighted by 1 / ns_per_ray (relative errors count alike). Kinds that no sample
+/// performs keep cost 0 and are reported as not fitted. Throws InputError with fewer samples
+/// than fitted unknowns.
+Calibration calibrate(std::span<const CalibrationSample> samples);
+
+/// Writes `c` as a costs file that UnitCosts::read reads (atomically).
+void write_costs(const std::string& path, const Calibration& c, std::span<const CalibrationSample> samples);
 
 /// The measured counterpart of a CostVector: per-ray means of the counters.
 CostVector measured_cost(const RayCounters& c);
@@ -83,8 +109,10 @@ struct Prediction {
 
 /// Geometric estimator: probabilities from surface areas of each node's entry region for
 /// isotropic lines through the root box. P of a node over several primitives is approximated
-/// as 1 - prod(1 - p_i), p_i = S_i / S(region) with S_i the primitive's area seen from both
-/// sides (2x for flat primitives), scaled by the share of its bounding box inside the region.
+/// by the Poisson form 1 - exp(-sum p_i), p_i = S_i / S(region) with S_i the primitive's area
+/// seen from both sides (2x for flat primitives), scaled by the share of its bounding box
+/// inside the region. 5D classification trees (ModelTree::one_path): each beam's probability
+/// under the line measure by numerical integration.
 Prediction predict_geometric(const ModelTree& tree, const Scene& scene, const ModelOptions& opt,
                              const UnitCosts& costs = {});
 

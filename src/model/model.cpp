@@ -13,7 +13,7 @@
 namespace rtcost {
 
 double UnitCosts::scalar(const CostVector& c) const {
-    double s = box * c.box + plane * c.plane + hop * c.hop + classify * c.classify;
+    double s = per_ray + box * c.box + plane * c.plane + hop * c.hop + classify * c.classify;
     for (int k = 0; k < kPrimKinds; ++k) s += prim[k] * c.prim[k];
     return s;
 }
@@ -38,6 +38,7 @@ UnitCosts UnitCosts::read(const std::string& path) {
     get(j, "plane", u.plane);
     get(j, "hop", u.hop);
     get(j, "classify", u.classify);
+    get(j, "per_ray", u.per_ray);
     if (j.contains("prim")) {
         for (int k = 0; k < kPrimKinds; ++k)
             get(j["prim"], std::string(prim_kind_name(static_cast<PrimKind>(k))).c_str(), u.prim[k]);

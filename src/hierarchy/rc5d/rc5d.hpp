@@ -87,6 +87,7 @@ public:
 
     std::string_view name() const override { return "rc5d"; }
     ModelTree model_tree() const override;
+    bool lazy() const override { return opt_.lazy; }
 
     const Options& options() const { return opt_; }
     /// Memory currently held, as accounted against `max_bytes` (equals structure().bytes).

@@ -1,0 +1,114 @@
+// `rtcost calibrate`: fit nanoseconds per operation kind to measured single-thread times.
+#include <iostream>
+
+#include "cli.hpp"
+#include "rtcost/model.hpp"
+
+namespace rtcost::cli {
+namespace {
+using nlohmann::json;
+
+struct CalibrateArgs {
+    std::vector<std::string> scenes{"builtin:balls:3", "builtin:tetra:5", "builtin:balls"};
+    std::string hierarchies = "all";
+    RaySpec rays;
+    int repeat = 3;
+    std::string out = "costs.json";
+};
+
+int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
+    std::vector<std::string> names;
+    if (a.hierarchies == "all") {
+        for (const HierarchyInfo* h : hierarchies())
+            if (h->name != "embree") names.push_back(h->name);  // Embree's operations are not counted
+    } else {
+        std::size_t start = 0;
+        while (start <= a.hierarchies.size()) {
+            std::size_t comma = std::min(a.hierarchies.find(',', start), a.hierarchies.size());
+            if (comma > start) names.push_back(a.hierarchies.substr(start, comma - start));
+            start = comma + 1;
+        }
+    }
+    std::vector<CalibrationSample> samples;
+    Progress progress("calibrate", a.scenes.size() * names.size(), common.quiet || common.json);
+    for (const std::string& spec : a.scenes) {
+        Scene scene = load(spec, common);
+        RaySet rays = make_rays(scene, a.rays);
+        for (const std::string& name : names) {
+            auto h = build_hierarchy(scene, name);
+            TraceOptions opt;
+            opt.threads = 1;  // unit costs are single-thread figures
+            // The fastest of several runs: the least disturbed by the machine (and, for lazily
+            // built structures, the runs after the build).
+            double best = kInf;
+            for (int r = 0; r < a.repeat; ++r) best = std::min(best, trace_ray_set(*h, rays, opt).seconds);
+            opt.count = true;
+            TraceResult counted = trace_ray_set(*h, rays, opt);
+            CalibrationSample s;
+            s.label = name + " on " + scene.name;
+            s.ops = measured_cost(counted.counters);
+            s.ns_per_ray = rays.rays.empty() ? 0.0 : best * 1e9 / rays.rays.size();
+            samples.push_back(std::move(s));
+            progress.update(samples.size());
+        }
+    }
+    progress.finish();
+    Calibration c = calibrate(samples);
+    write_costs(a.out, c, samples);
+
+    static const char* kKinds[] = {"box", "plane", "hop", "classify"};
+    if (common.json) {
+        json fit = json::object();
+        for (int k = 0; k < 4; ++k) fit[kKinds[k]] = c.fitted[k] ? json(k == 0 ? c.costs.box : k == 1 ? c.costs.plane : k == 2 ? c.costs.hop : c.costs.classify) : json(nullptr);
+        for (int k = 0; k < kPrimKinds; ++k)
+            fit[std::string(prim_kind_name(static_cast<PrimKind>(k)))] = c.fitted[4 + k] ? json(c.costs.prim[k]) : json(nullptr);
+        fit["per_ray"] = c.costs.per_ray;
+        json runs = json::array();
+        for (std::size_t i = 0; i < samples.size(); ++i)
+            runs.push_back({{"run", samples[i].label}, {"measured_ns_per_ray", samples[i].ns_per_ray},
+                            {"fitted_ns_per_ray", c.predicted[i]},
+                            {"residual", (c.predicted[i] - samples[i].ns_per_ray) / samples[i].ns_per_ray}});
+        std::cout << json{{"costs_file", a.out}, {"ns_per_operation", fit}, {"rms_relative_residual", c.rms_relative},
+                          {"runs", runs}}
+                         .dump(2)
+                  << "\n";
+        return 0;
+    }
+    fmt::print("unit costs (ns per operation, single thread), fitted over {} runs:\n", samples.size());
+    const double vals[] = {c.costs.box, c.costs.plane, c.costs.hop, c.costs.classify};
+    for (int k = 0; k < 4; ++k)
+        fmt::print("  {:<10} {}\n", kKinds[k], c.fitted[k] ? fmt::format("{:.3f}", vals[k]) : "(not exercised)");
+    for (int k = 0; k < kPrimKinds; ++k)
+        fmt::print("  {:<10} {}\n", prim_kind_name(static_cast<PrimKind>(k)),
+                   c.fitted[4 + k] ? fmt::format("{:.3f}", c.costs.prim[k]) : "(not exercised)");
+    fmt::print("  {:<10} {:.3f}\n", "per ray", c.costs.per_ray);
+    fmt::print("\n{:<36} {:>12} {:>12} {:>9}\n", "run", "measured ns", "fitted ns", "residual");
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        fmt::print("{:<36} {:>12.1f} {:>12.1f} {:>+8.1f}%\n", samples[i].label, samples[i].ns_per_ray, c.predicted[i],
+                   100 * (c.predicted[i] - samples[i].ns_per_ray) / samples[i].ns_per_ray);
+    fmt::print("\nrms relative residual {:.1f}%; written to {} (use with eval --costs)\n", 100 * c.rms_relative, a.out);
+    return 0;
+}
+
+Subcommand setup_calibrate(CLI::App& parent, Common& common) {
+    auto a = std::make_shared<CalibrateArgs>();
+    a->rays.size = "128x128";
+    auto* cmd = parent.add_subcommand("calibrate",
+                                      "fit nanoseconds per operation kind (least squares over measured counts and "
+                                      "single-thread times) and write a costs file for eval --costs");
+    cmd->add_option("SCENES", a->scenes, "scenes to measure on")->capture_default_str();
+    cmd->add_option("-H,--hierarchy", a->hierarchies, "comma-separated hierarchies, or all (but embree)")
+        ->capture_default_str();
+    add_ray_args(cmd, a->rays);
+    cmd->add_option("--repeat", a->repeat, "timed runs per hierarchy and scene (the fastest counts)")
+        ->check(CLI::Range(1, 100))
+        ->capture_default_str();
+    cmd->add_option("-o,--out", a->out, "costs file to write")->capture_default_str();
+    add_common(cmd, common);
+    return {cmd, [a, &common] { return cmd_calibrate(*a, common); }};
+}
+
+const CommandRegistration reg{45, setup_calibrate};
+
+}  // namespace
+}  // namespace rtcost::cli

@@ -1,0 +1,172 @@
+// Fitting nanoseconds per operation kind to measured times: the model's unit-cost table.
+// Non-negative least squares (Lawson and Hanson's active-set method) is written here because
+// the problem has at most nine unknowns and no Debian-packaged C++ library offers NNLS; the
+// normal equations of each passive set are solved by Gaussian elimination.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "rtcost/error.hpp"
+#include "rtcost/model.hpp"
+
+namespace rtcost {
+namespace {
+
+constexpr int kUnknowns = 4 + kPrimKinds + 1;  // box, plane, hop, classify, prims, per_ray
+
+std::array<double, kUnknowns> row_of(const CostVector& c) {
+    std::array<double, kUnknowns> r{};
+    r[0] = c.box;
+    r[1] = c.plane;
+    r[2] = c.hop;
+    r[3] = c.classify;
+    for (int k = 0; k < kPrimKinds; ++k) r[4 + k] = c.prim[k];
+    r[kUnknowns - 1] = 1;
+    return r;
+}
+
+/// Least squares restricted to the columns in `passive`; others are zero in the result.
+std::vector<double> solve_passive(const std::vector<std::vector<double>>& a, const std::vector<double>& b,
+                                  const std::vector<int>& passive, int n) {
+    const int m = static_cast<int>(passive.size());
+    std::vector<std::vector<double>> g(m, std::vector<double>(m + 1, 0.0));
+    for (std::size_t r = 0; r < a.size(); ++r) {
+        for (int i = 0; i < m; ++i) {
+            for (int j = 0; j < m; ++j) g[i][j] += a[r][passive[i]] * a[r][passive[j]];
+            g[i][m] += a[r][passive[i]] * b[r];
+        }
+    }
+    for (int c = 0; c < m; ++c) {
+        int piv = c;
+        for (int r = c + 1; r < m; ++r)
+            if (std::fabs(g[r][c]) > std::fabs(g[piv][c])) piv = r;
+        std::swap(g[c], g[piv]);
+        if (std::fabs(g[c][c]) < 1e-300) continue;  // singular column: leave it at zero
+        for (int r = 0; r < m; ++r) {
+            if (r == c) continue;
+            double f = g[r][c] / g[c][c];
+            for (int k = c; k <= m; ++k) g[r][k] -= f * g[c][k];
+        }
+    }
+    std::vector<double> x(n, 0.0);
+    for (int i = 0; i < m; ++i) x[passive[i]] = std::fabs(g[i][i]) < 1e-300 ? 0.0 : g[i][m] / g[i][i];
+    return x;
+}
+
+std::vector<double> nnls(const std::vector<std::vector<double>>& a, const std::vector<double>& b,
+                         const std::vector<bool>& usable) {
+    const int n = static_cast<int>(usable.size());
+    std::vector<double> x(n, 0.0);
+    std::vector<bool> in_p(n, false);
+    auto gradient = [&] {
+        std::vector<double> w(n, 0.0);
+        for (std::size_t r = 0; r < a.size(); ++r) {
+            double res = b[r];
+            for (int j = 0; j < n; ++j) res -= a[r][j] * x[j];
+            for (int j = 0; j < n; ++j) w[j] += a[r][j] * res;
+        }
+        return w;
+    };
+    for (int outer = 0; outer < 3 * n; ++outer) {
+        std::vector<double> w = gradient();
+        int best = -1;
+        for (int j = 0; j < n; ++j)
+            if (usable[j] && !in_p[j] && w[j] > 1e-12 && (best < 0 || w[j] > w[best])) best = j;
+        if (best < 0) break;
+        in_p[best] = true;
+        for (int inner = 0; inner < 3 * n; ++inner) {
+            std::vector<int> passive;
+            for (int j = 0; j < n; ++j)
+                if (in_p[j]) passive.push_back(j);
+            std::vector<double> z = solve_passive(a, b, passive, n);
+            bool feasible = true;
+            for (int j : passive) feasible &= z[j] > 0;
+            if (feasible) {
+                x = z;
+                break;
+            }
+            double alpha = 1;
+            for (int j : passive)
+                if (z[j] <= 0) alpha = std::min(alpha, x[j] / (x[j] - z[j]));
+            for (int j = 0; j < n; ++j) x[j] += alpha * (z[j] - x[j]);
+            for (int j : passive)
+                if (x[j] <= 1e-12) {
+                    in_p[j] = false;
+                    x[j] = 0;
+                }
+        }
+    }
+    return x;
+}
+
+}  // namespace
+
+Calibration calibrate(std::span<const CalibrationSample> samples) {
+    std::vector<bool> usable(kUnknowns, false);
+    std::vector<std::vector<double>> a;
+    std::vector<double> b;
+    for (const CalibrationSample& s : samples) {
+        if (!(s.ns_per_ray > 0) || !std::isfinite(s.ns_per_ray))
+            throw InputError("calibrate", 0, "sample '" + s.label + "' has no positive time");
+        auto r = row_of(s.ops);
+        // Relative weighting: divide each equation by the measured time.
+        std::vector<double> row(kUnknowns);
+        for (int j = 0; j < kUnknowns; ++j) {
+            row[j] = r[j] / s.ns_per_ray;
+            usable[j] = usable[j] || r[j] > 0;
+        }
+        a.push_back(std::move(row));
+        b.push_back(1.0);
+    }
+    int fitted = static_cast<int>(std::count(usable.begin(), usable.end(), true));
+    if (static_cast<int>(samples.size()) < fitted)
+        throw InputError("calibrate", 0,
+                         "need at least " + std::to_string(fitted) + " runs (hierarchy x scene) to fit " +
+                             std::to_string(fitted) + " unit costs, have " + std::to_string(samples.size()));
+    std::vector<double> x = nnls(a, b, usable);
+    Calibration c;
+    c.costs.box = x[0];
+    c.costs.plane = x[1];
+    c.costs.hop = x[2];
+    c.costs.classify = x[3];
+    for (int k = 0; k < kPrimKinds; ++k) c.costs.prim[k] = x[4 + k];
+    c.costs.per_ray = x[kUnknowns - 1];
+    c.costs.calibrated = true;
+    c.fitted = usable;
+    double sum2 = 0;
+    for (const CalibrationSample& s : samples) {
+        double p = c.costs.scalar(s.ops);
+        c.predicted.push_back(p);
+        double rel = (p - s.ns_per_ray) / s.ns_per_ray;
+        sum2 += rel * rel;
+    }
+    c.rms_relative = samples.empty() ? 0.0 : std::sqrt(sum2 / samples.size());
+    return c;
+}
+
+void write_costs(const std::string& path, const Calibration& c, std::span<const CalibrationSample> samples) {
+    nlohmann::json prim = nlohmann::json::object();
+    for (int k = 0; k < kPrimKinds; ++k) prim[std::string(prim_kind_name(static_cast<PrimKind>(k)))] = c.costs.prim[k];
+    nlohmann::json fits = nlohmann::json::array();
+    for (std::size_t i = 0; i < samples.size(); ++i)
+        fits.push_back({{"run", samples[i].label},
+                        {"measured_ns_per_ray", samples[i].ns_per_ray},
+                        {"fitted_ns_per_ray", c.predicted[i]}});
+    nlohmann::json j = {{"unit", "ns"},       {"box", c.costs.box},           {"plane", c.costs.plane},
+                        {"hop", c.costs.hop}, {"classify", c.costs.classify}, {"prim", prim},
+                        {"per_ray", c.costs.per_ray}, {"rms_relative_residual", c.rms_relative},
+                        {"runs", fits}};
+    // Written beside the target and renamed, so a failure leaves no half-written file.
+    std::string tmp = path + ".tmp";
+    {
+        std::ofstream out(tmp);
+        if (!out) throw InputError(path, 0, "cannot write");
+        out << j.dump(2) << "\n";
+        if (!out.flush()) throw InputError(path, 0, "write failed");
+    }
+    std::filesystem::rename(tmp, path);
+}
+
+}  // namespace rtcost
