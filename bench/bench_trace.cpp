@@ -10,6 +10,7 @@
 
 #include "rtcost/hierarchy.hpp"
 #include "rtcost/io.hpp"
+#include "rtcost/model.hpp"
 #include "rtcost/rays.hpp"
 
 using namespace rtcost;
@@ -69,13 +70,32 @@ void build_bench(benchmark::State& state, std::string scene, std::string hierarc
     state.counters["prims"] = static_cast<double>(w.scene.size());
 }
 
+/// The geometric estimator alone (model tree walk and prediction), after the build: the cost of
+/// predicting instead of measuring.
+void model_bench(benchmark::State& state, std::string scene, std::string hierarchy) {
+    Workload& w = workload(scene);
+    auto h = build_hierarchy(w.scene, hierarchy);
+    ModelOptions opt;
+    for (auto _ : state) {
+        Prediction p = predict_geometric(h->model_tree(), w.scene, opt);
+        benchmark::DoNotOptimize(p.scalar);
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     const std::vector<std::string> scenes = {"tetra", "balls", "mount-s8"};
-    const std::vector<std::string> hier = {"embree", "bvh-sah", "bvh-median", "bvh-gs"};
+    std::vector<std::string> hier;
+    for (const char* h : {"embree", "bvh-sah", "bvh-median", "bvh-gs", "kd-sah", "kd-median", "bsp", "octree", "grid",
+                          "rc5d"})
+        if (find_hierarchy(h)) hier.push_back(h);
     for (const auto& s : scenes) {
         for (const auto& h : hier) {
+            if (h != "embree")
+                benchmark::RegisterBenchmark(("model/" + s + "/" + h).c_str(), model_bench, s, h)
+                    ->Unit(benchmark::kMillisecond)
+                    ->MinTime(0.2);
             for (const char* d : {"random", "camera"}) {
                 benchmark::RegisterBenchmark(("trace/" + s + "/" + d + "/" + h).c_str(), trace_bench, s, h, d)
                     ->Unit(benchmark::kMillisecond)

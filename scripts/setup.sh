@@ -6,4 +6,4 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
 ./build/rtcost info builtin:balls
-./build/rtcost trace builtin:tetra --hierarchy brute --rays camera --size 128x128
+./build/rtcost eval builtin:balls --rays camera --size 256x256 --estimator sampled
