@@ -64,6 +64,7 @@ struct EvalRow {
     StructureStats s;
     bool modelled = false;
     Prediction pred;
+    std::vector<Prediction> preds;  // every estimator x preset asked for; pred is the first
     CostVector meas;
     std::vector<double> meas_visits;
     double meas_scalar = 0, error = 0, mrays = 0;
@@ -101,7 +102,12 @@ int cmd_eval(EvalArgs& a, const Common& common) {
         throw InputError("--set", 0, "parameters apply to one hierarchy: name a single one with --hierarchy");
     RaySet test = make_rays(scene, a.rays);
     const std::string described = test.described;
-    const bool sampled = a.estimator == "sampled";
+    // Estimators and presets to evaluate; the first of each is the headline prediction.
+    std::vector<std::string> estimators = a.estimator == "both" ? std::vector<std::string>{"sampled", "geometric"}
+                                                                : std::vector<std::string>{a.estimator};
+    std::vector<std::string> presets =
+        a.preset == "both" ? std::vector<std::string>{"exact", "paper"} : std::vector<std::string>{a.preset};
+    const bool sampled = std::find(estimators.begin(), estimators.end(), "sampled") != estimators.end();
     RaySet train;
     if (sampled) {
         // A training sample disjoint from the test rays: a fresh draw for random distributions,
@@ -181,19 +187,26 @@ int cmd_eval(EvalArgs& a, const Common& common) {
                 for (int k = 0; k < kRayKinds; ++k) train_hits[k] = trace_rays(*h, train_kinds[k]).hits;
                 have_train_hits = true;
             }
-            std::vector<std::pair<double, Prediction>> parts;
-            for (int k = 0; k < kRayKinds; ++k) {
-                if (test_kinds[k].empty()) continue;
-                ModelOptions o = mo;
-                o.query = query_of(k);
-                double share = static_cast<double>(test_kinds[k].size()) / test.rays.size();
-                if (sampled && train_kinds[k].empty())
-                    throw InputError("--sample", 0, "no training rays of kind " +
-                                                        std::string(ray_kind_name(static_cast<RayKind>(k))));
-                parts.emplace_back(share, sampled ? predict_sampled(tree, scene, train_kinds[k], train_hits[k], o, costs)
-                                                  : predict_geometric(tree, scene, o, costs));
+            for (const std::string& est : estimators) {
+                for (const std::string& preset : presets) {
+                    std::vector<std::pair<double, Prediction>> parts;
+                    for (int k = 0; k < kRayKinds; ++k) {
+                        if (test_kinds[k].empty()) continue;
+                        ModelOptions o = mo;
+                        o.preset = preset == "paper" ? Preset::Paper : Preset::Exact;
+                        o.query = query_of(k);
+                        double share = static_cast<double>(test_kinds[k].size()) / test.rays.size();
+                        if (est == "sampled" && train_kinds[k].empty())
+                            throw InputError("--sample", 0, "no training rays of kind " +
+                                                                std::string(ray_kind_name(static_cast<RayKind>(k))));
+                        parts.emplace_back(share, est == "sampled" ? predict_sampled(tree, scene, train_kinds[k],
+                                                                                     train_hits[k], o, costs)
+                                                                   : predict_geometric(tree, scene, o, costs));
+                    }
+                    row.preds.push_back(mix(parts, costs));
+                }
             }
-            row.pred = mix(parts, costs);
+            row.pred = row.preds.front();
         }
         row.meas = measured_cost(counted.counters);
         row.meas_scalar = costs.scalar(row.meas);
@@ -223,6 +236,17 @@ int cmd_eval(EvalArgs& a, const Common& common) {
                 j["error"] = r.error;
                 j["rank_predicted"] = r.rank_pred;
                 j["note"] = r.pred.note + (r.lazy ? "; lazily built: modelled over the beams built by the rays so far" : "");
+                if (r.preds.size() > 1) {
+                    json all = json::array();
+                    for (const Prediction& p : r.preds) {
+                        json e = cost_json(p.cost, p.scalar);
+                        e["estimator"] = p.estimator;
+                        e["preset"] = p.preset;
+                        e["error"] = r.meas_scalar > 0 ? (p.scalar - r.meas_scalar) / r.meas_scalar : 0.0;
+                        all.push_back(e);
+                    }
+                    j["predictions"] = all;
+                }
             } else {
                 j["predicted"] = nullptr;
             }
@@ -233,16 +257,17 @@ int cmd_eval(EvalArgs& a, const Common& common) {
             results.push_back(j);
         }
         json out = {{"scene", scene.name},       {"primitives", scene.size()}, {"rays", test.rays.size()},
-                    {"distribution", described}, {"query", a.query},     {"estimator", a.estimator},
-                    {"preset", a.preset},        {"training_rays", train.rays.size()},
+                    {"distribution", described}, {"query", a.query},     {"estimator", estimators.front()},
+                    {"preset", presets.front()},  {"training_rays", train.rays.size()},
                     {"unit_costs", costs.calibrated ? "ns" : "operations"}, {"results", results}};
         std::cout << out.dump(2) << "\n";
         return 0;
     }
     fmt::print("scene {} ({} primitives), {} test rays ({}), {} query\n", scene.name, scene.size(), test.rays.size(),
                described, a.query);
-    fmt::print("model: {} estimator{}, {} preset, costs in {}\n", a.estimator,
-               sampled ? fmt::format(" ({} training rays)", train.rays.size()) : std::string(), a.preset,
+    fmt::print("model: {} estimator{}, {} preset, costs in {}\n", estimators.front(),
+               estimators.front() == "sampled" ? fmt::format(" ({} training rays)", train.rays.size()) : std::string(),
+               presets.front(),
                costs.calibrated ? "ns" : "operations");
     fmt::print("{:<12} {:>9} {:>9} {:>10} {:>11} {:>11} {:>8} {:>9} {:>5} {:>5}\n", "hierarchy", "build s", "nodes",
                "bytes", "predicted", "measured", "error", "Mrays/s", "rk-p", "rk-m");
@@ -252,6 +277,19 @@ int cmd_eval(EvalArgs& a, const Common& common) {
                    r.modelled ? fmt::format("{:.2f}", r.pred.scalar) : "-", r.meas_scalar,
                    r.modelled ? fmt::format("{:+.1f}%", 100 * r.error) : "-", r.mrays,
                    r.modelled ? std::to_string(r.rank_pred) : "-", r.rank_meas);
+    }
+    if (!rows.empty() && rows[0].preds.size() > 1) {
+        fmt::print("\nevery prediction (cost per ray, error):\n{:<12}", "hierarchy");
+        for (const Prediction& p : rows[0].preds) fmt::print(" {:>22}", p.estimator + "/" + p.preset);
+        fmt::print("\n");
+        for (const auto& r : rows) {
+            if (!r.modelled) continue;
+            fmt::print("{:<12}", r.name);
+            for (const Prediction& p : r.preds)
+                fmt::print(" {:>22}", fmt::format("{:.2f} ({:+.1f}%)", p.scalar,
+                                                  r.meas_scalar > 0 ? 100 * (p.scalar - r.meas_scalar) / r.meas_scalar : 0.0));
+            fmt::print("\n");
+        }
     }
     if (costs.calibrated) {
         fmt::print("\ntime per ray (calibrated unit costs; measured on {} thread{}):\n", rows.empty() ? 1 : rows[0].threads,
@@ -302,11 +340,11 @@ Subcommand setup_eval(CLI::App& parent, Common& common) {
         ->check(CLI::IsMember({"closest", "any"}))
         ->capture_default_str();
     eval->add_option("--estimator", a->estimator,
-                     "geometric (surface areas, no rays traced) or sampled (probabilities from training rays)")
-        ->check(CLI::IsMember({"geometric", "sampled"}))
+                     "geometric (surface areas, no rays traced), sampled (probabilities from training rays), or both")
+        ->check(CLI::IsMember({"geometric", "sampled", "both"}))
         ->capture_default_str();
-    eval->add_option("--preset", a->preset, "exact (every operation performed) or paper (the seed's formulas)")
-        ->check(CLI::IsMember({"exact", "paper"}))
+    eval->add_option("--preset", a->preset, "exact (every operation performed), paper (the seed's formulas), or both")
+        ->check(CLI::IsMember({"exact", "paper", "both"}))
         ->capture_default_str();
     eval->add_option("--sample", a->sample, "training rays for the sampled estimator")->capture_default_str();
     eval->add_option("--costs", a->costs, "unit costs file (JSON, from rtcost calibrate)");

@@ -90,6 +90,9 @@ struct NodeProbabilities {
     /// children need not cover their parent.
     double both = 0;
     double p_hit = 0;   ///< P: the segment handed to the node hits inside its region
+    /// P where the recursion uses it: among segments that meet both children of the parent
+    /// with this node first (sampled estimator; negative: use p_hit).
+    double p_first = -1;
     double p_bv = 1;    ///< the segment meets the node's bounding volume (when it has one)
     /// Leaves of one-path trees (5D) searched in order: expected candidates tested per visit, by
     /// kind, when the search may stop early.

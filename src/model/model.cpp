@@ -215,7 +215,8 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
         } else if (q.split) {
             const std::uint32_t b = m.first, cc = m.first + 1;
             const double both = q.both;
-            const double pb = terminate ? prob[b].p_hit : 0.0, pc = terminate ? prob[cc].p_hit : 0.0;
+            auto p_end = [&](std::uint32_t x) { return prob[x].p_first >= 0 ? prob[x].p_first : prob[x].p_hit; };
+            const double pb = terminate ? p_end(b) : 0.0, pc = terminate ? p_end(cc) : 0.0;
             double g = q.gamma;
             pi[b] = pg * (q.alpha + both * (g + (1 - g) * (1 - pc)));
             pi[cc] = pg * (q.beta + both * ((1 - g) + g * (1 - pb)));
@@ -511,6 +512,7 @@ Prediction predict_sampled(const ModelTree& t, const Scene& scene, std::span<con
     // Per-node tallies of the probe walk.
     struct Tally {
         double handed = 0, gated = 0, left = 0, right = 0, both = 0, left_first = 0, hit = 0, met = 0;
+        double first = 0, first_ends = 0;  // met both with this node first; and the hit lay in it
     };
     std::vector<Tally> tally(n);
     // P of a node: the ray's closest hit lies within the node's part of the segment. (For
@@ -600,8 +602,13 @@ Prediction predict_sampled(const ModelTree& t, const Scene& scene, std::span<con
                     ty.left_first += left_first;
                     Item near{left_first ? m.first : m.first + 1, left_first ? sl : sr};
                     Item far{left_first ? m.first + 1 : m.first, left_first ? sr : sl};
-                    bool ends = terminate && ends_in(near.node, near.s, r);
-                    if (!ends) stack.push_back(far);
+                    // Bounding volumes overlap: the far child is skipped when the closest hit lies
+                    // before its entry (found in the near child or earlier), not merely in the near box.
+                    bool near_ends = disjoint ? closest[r].hit() && closest[r].t < far.s.t0
+                                              : ends_in(near.node, near.s, r);
+                    tally[near.node].first += 1;
+                    tally[near.node].first_ends += near_ends;
+                    if (!(terminate && near_ends)) stack.push_back(far);
                     stack.push_back(near);
                 }
             } else {
@@ -621,6 +628,8 @@ Prediction predict_sampled(const ModelTree& t, const Scene& scene, std::span<con
         NodeProbabilities& q = prob[i];
         q.p_bv = ty.handed > 0 ? ty.gated / ty.handed : 0.0;
         q.p_hit = ty.gated > 0 ? ty.hit / ty.gated : 0.0;
+        // P conditioned the way the recursion uses it: this node first, its sibling still ahead.
+        if (ty.first > 0) q.p_first = ty.first_ends / ty.first;
         if (m.leaf) continue;
         if (m.count == 2) {
             q.split = true;
