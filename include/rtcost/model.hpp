@@ -83,17 +83,18 @@ struct ModelOptions {
 
 /// Per-node probabilities that drive the recursion.
 struct NodeProbabilities {
-    double handed = 0;  ///< segments handed to the node (sampled) or pi (geometric)
+    // Floats: one per node of trees with millions of nodes, and probabilities need no more.
+    float handed = 0;  ///< segments handed to the node (sampled) or pi (geometric)
     bool split = false;  ///< alpha, beta, gamma hold for this two-child node
-    double alpha = 0, beta = 0, gamma = 0.5;  ///< left only, right only, left first when both
+    float alpha = 0, beta = 0, gamma = 0.5;  ///< left only, right only, left first when both
     /// Both children met: 1 - alpha - beta for a plane split; less for bounding volumes, whose
     /// children need not cover their parent.
-    double both = 0;
-    double p_hit = 0;   ///< P: the segment handed to the node hits inside its region
+    float both = 0;
+    float p_hit = 0;   ///< P: the segment handed to the node hits inside its region
     /// P where the recursion uses it: among segments that meet both children of the parent
     /// with this node first (sampled estimator; negative: use p_hit).
-    double p_first = -1;
-    double p_bv = 1;    ///< the segment meets the node's bounding volume (when it has one)
+    float p_first = -1;
+    float p_bv = 1;    ///< the segment meets the node's bounding volume (when it has one)
     /// Leaves of one-path trees (5D) searched in order: expected candidates tested per visit, by
     /// kind, when the search may stop early.
     bool ordered = false;

@@ -110,26 +110,29 @@ struct Walk {
     std::vector<int> parent;
     std::vector<int> tdepth;      // traversal depth: number of step ancestors
     std::vector<Box3> visit_box;  // V(N): where a segment must pass for N to be visited
-    std::vector<Box3> gate_box;   // V(N) within N's bounding volume, when it has one
 
     explicit Walk(const ModelTree& tree) : t(tree) {
         const std::size_t n = t.nodes.size();
         parent.assign(n, -1);
         tdepth.assign(n, 0);
         visit_box.resize(n);
-        gate_box.resize(n);
         visit_box[0] = t.nodes[0].region;
         for (std::size_t i = 0; i < n; ++i) {
             const ModelNode& m = t.nodes[i];
-            gate_box[i] = m.has_bv ? intersect(visit_box[i], m.bv) : visit_box[i];
             if (m.leaf) continue;
+            const Box3 gate = gate_box(i);
             for (std::uint32_t k = 0; k < m.count; ++k) {
                 std::uint32_t c = m.first + k;
                 parent[c] = static_cast<int>(i);
                 tdepth[c] = tdepth[i] + (m.step ? 1 : 0);
-                visit_box[c] = intersect(gate_box[i], t.nodes[c].region);
+                visit_box[c] = intersect(gate, t.nodes[c].region);
             }
         }
+    }
+    /// V(N) within N's bounding volume, when it has one.
+    Box3 gate_box(std::size_t i) const {
+        const ModelNode& m = t.nodes[i];
+        return m.has_bv ? intersect(visit_box[i], m.bv) : visit_box[i];
     }
 };
 
@@ -174,6 +177,7 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
         }
     };
 
+    std::vector<double> e;  // reused: no allocation per node
     for (std::size_t i = 0; i < n; ++i) {
         const ModelNode& m = t.nodes[i];
         const NodeProbabilities& q = prob[i];
@@ -231,7 +235,7 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
                 double met_x = prob[cx].handed;  // P(X | parent) stored in `handed`
                 double survive = 1.0;
                 if (terminate && k > 1) {
-                    std::vector<double> e(k, 0.0);  // e[j]: elementary symmetric polynomial of degree j
+                    e.assign(k, 0.0);  // e[j]: elementary symmetric polynomial of degree j
                     e[0] = 1;
                     std::uint32_t used = 0;
                     for (std::uint32_t y = 0; y < k; ++y) {
@@ -478,7 +482,7 @@ Prediction predict_geometric(const ModelTree& t, const Scene& scene, const Model
     for (std::size_t i = 0; i < n; ++i) {
         const ModelNode& m = t.nodes[i];
         NodeProbabilities& q = prob[i];
-        double sv = surface(w.visit_box[i]), sg = surface(w.gate_box[i]);
+        double sv = surface(w.visit_box[i]), sg = surface(w.gate_box(i));
         q.p_bv = sv > 0 ? sg / sv : 0.0;
         q.p_hit = sv > 0 ? 1 - std::exp(-inside[i] / sv) : 0.0;
         if (m.leaf) continue;
@@ -487,7 +491,7 @@ Prediction predict_geometric(const ModelTree& t, const Scene& scene, const Model
             double sl = surface(w.visit_box[m.first]), sr = surface(w.visit_box[m.first + 1]);
             q.alpha = sg > 0 ? 1 - sr / sg : 0.0;
             q.beta = sg > 0 ? 1 - sl / sg : 0.0;
-            q.both = std::max(0.0, 1 - q.alpha - q.beta);
+            q.both = std::max(0.0f, 1 - q.alpha - q.beta);
             q.gamma = 0.5;  // isotropic lines: either side first with equal probability
         } else {
             for (std::uint32_t k = 0; k < m.count; ++k) {
