@@ -88,7 +88,7 @@ private:
         const Node* nodes = d_.nodes.data();
         const RayInv ri(ray);
         counting.box();
-        float t0 = box_entry(nodes[0].box, ri.o, ri.inv, ray.tmin, ray.tmax);
+        float t0 = box_entry(nodes[0].box, ri, ray.tmin, ray.tmax);
         if (t0 == kInf) return false;
         stack[sp++] = {0, t0, 0};
         bool found = false;
@@ -114,7 +114,7 @@ private:
             int nh = 0;
             for (std::uint32_t k = 0; k < n.count; ++k) {
                 counting.box();
-                float t = box_entry(nodes[n.index + k].box, ri.o, ri.inv, ray.tmin, limit);
+                float t = box_entry(nodes[n.index + k].box, ri, ray.tmin, limit);
                 if (t != kInf) hits[nh++] = {n.index + k, t, e.depth + 1};
             }
             if constexpr (kOrdered) {
