@@ -90,45 +90,74 @@ private:
         counting.box();
         float t0 = box_entry(nodes[0].box, ri, ray.tmin, ray.tmax);
         if (t0 == kInf) return false;
-        stack[sp++] = {0, t0, 0};
         bool found = false;
-        while (sp > 0) {
-            const Entry e = stack[--sp];
-            if constexpr (kOrdered) {
-                if (e.t >= hit.t) continue;  // the whole box lies beyond the current hit
-            }
-            const Node& n = nodes[e.node];
-            if (n.leaf) {
-                counting.leaf(e.depth, n.count);
-                for (std::uint32_t k = 0; k < n.count; ++k) {
-                    if (test_prim(*scene_, d_.refs[n.index + k], ray, hit, counting)) {
-                        found = true;
-                        if constexpr (Q == Query::Any) return true;
+        // The entry being visited; a binary node continues straight into its near child.
+        Entry e{0, t0, 0};
+        for (;;) {
+            // One visit; `e` is then either set to the next entry directly (a binary node's
+            // near child) or popped from the stack at `pop`.
+            {
+                if constexpr (kOrdered) {
+                    if (e.t >= hit.t) goto pop;  // the whole box lies beyond the current hit
+                }
+                const Node& n = nodes[e.node];
+                if (n.leaf) {
+                    counting.leaf(e.depth, n.count);
+                    for (std::uint32_t k = 0; k < n.count; ++k) {
+                        if (test_prim(*scene_, d_.refs[n.index + k], ray, hit, counting)) {
+                            found = true;
+                            if constexpr (Q == Query::Any) return true;
+                        }
                     }
+                    goto pop;
                 }
-                continue;
-            }
-            counting.interior(e.depth);
-            const float limit = kOrdered ? std::min(hit.t, ray.tmax) : ray.tmax;
-            Entry hits[kMaxFanout];
-            int nh = 0;
-            for (std::uint32_t k = 0; k < n.count; ++k) {
-                counting.box();
-                float t = box_entry(nodes[n.index + k].box, ri, ray.tmin, limit);
-                if (t != kInf) hits[nh++] = {n.index + k, t, e.depth + 1};
-            }
-            if constexpr (kOrdered) {
-                // Nearest last, so it is popped first. Fan-out is small: insertion sort.
-                for (int i = 1; i < nh; ++i) {
-                    Entry x = hits[i];
-                    int j = i - 1;
-                    for (; j >= 0 && hits[j].t < x.t; --j) hits[j + 1] = hits[j];
-                    hits[j + 1] = x;
+                counting.interior(e.depth);
+                const float limit = kOrdered ? std::min(hit.t, ray.tmax) : ray.tmax;
+                if (n.count == 2) {
+                    // Binary nodes (all but Goldsmith-Salmon's): no sort, and the near child is
+                    // visited next without a trip through the stack.
+                    counting.box();
+                    counting.box();
+                    const float ta = box_entry(nodes[n.index].box, ri, ray.tmin, limit);
+                    const float tb = box_entry(nodes[n.index + 1].box, ri, ray.tmin, limit);
+                    Entry a{n.index, ta, e.depth + 1}, b{n.index + 1, tb, e.depth + 1};
+                    if constexpr (kOrdered) {
+                        if (tb < ta) std::swap(a, b);
+                    }
+                    if (a.t != kInf) {
+                        if (b.t != kInf) stack[sp++] = b;
+                        e = a;
+                        continue;
+                    }
+                    if (b.t != kInf) {
+                        e = b;
+                        continue;
+                    }
+                    goto pop;
                 }
-                for (int i = 0; i < nh; ++i) stack[sp++] = hits[i];
-            } else {
-                for (int i = nh - 1; i >= 0; --i) stack[sp++] = hits[i];
+                Entry hits[kMaxFanout];
+                int nh = 0;
+                for (std::uint32_t k = 0; k < n.count; ++k) {
+                    counting.box();
+                    float t = box_entry(nodes[n.index + k].box, ri, ray.tmin, limit);
+                    if (t != kInf) hits[nh++] = {n.index + k, t, e.depth + 1};
+                }
+                if constexpr (kOrdered) {
+                    // Nearest last, so it is popped first. Fan-out is small: insertion sort.
+                    for (int i = 1; i < nh; ++i) {
+                        Entry x = hits[i];
+                        int j = i - 1;
+                        for (; j >= 0 && hits[j].t < x.t; --j) hits[j + 1] = hits[j];
+                        hits[j + 1] = x;
+                    }
+                    for (int i = 0; i < nh; ++i) stack[sp++] = hits[i];
+                } else {
+                    for (int i = nh - 1; i >= 0; --i) stack[sp++] = hits[i];
+                }
             }
+        pop:
+            if (sp == 0) break;
+            e = stack[--sp];
         }
         return found;
     }
