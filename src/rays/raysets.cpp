@@ -1,9 +1,12 @@
 // Named ray distributions: the one place that turns `--rays NAME` into rays.
 #include <fmt/format.h>
 
+#include <filesystem>
+
 #include "rtcost/error.hpp"
 #include "rtcost/io.hpp"
 #include "rtcost/rays.hpp"
+#include "rtcost/whitted.hpp"
 
 namespace rtcost {
 
@@ -22,7 +25,7 @@ std::string_view ray_kind_name(RayKind k) {
     return "?";
 }
 
-std::vector<std::string> distribution_names() { return {"camera", "lines", "random"}; }
+std::vector<std::string> distribution_names() { return {"camera", "spd", "shadow", "diffuse", "ao", "lines", "random"}; }
 
 namespace {
 RaySet uniform(std::vector<Ray> rays, RayKind kind, std::string described) {
@@ -47,6 +50,12 @@ RaySet make_rays(const Scene& scene, const RaySpec& spec) {
     if (spec.name == "random")
         return uniform(random_rays(scene.bounds(), spec.count, spec.seed), RayKind::Test,
                        fmt::format("random {} seed {}", spec.count, spec.seed));
+    if (is_tree_distribution(spec.name)) return make_tree_rays(scene, spec);
+    if (std::error_code ec; !std::filesystem::exists(spec.name, ec)) {
+        std::string names;
+        for (const auto& n : distribution_names()) names += (names.empty() ? "" : ", ") + n;
+        throw InputError(spec.name, 0, "no such file, and not a distribution (" + names + ")");
+    }
     return uniform(read_rays(spec.name), RayKind::File, spec.name);
 }
 

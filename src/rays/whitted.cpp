@@ -1,0 +1,294 @@
+// The Whitted ray tree (SPD testing procedure), rays spawned from camera hits, and the shared
+// recursion that render.cpp shades with. See whitted.hpp for the conventions.
+#include "rays/whitted_tracer.hpp"
+
+#include <fmt/format.h>
+
+#include <atomic>
+#include <cmath>
+#include <mutex>
+#include <numbers>
+#include <oneapi/tbb/blocked_range.h>
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_arena.h>
+
+#include "rtcost/error.hpp"
+#include "rtcost/trace.hpp"
+
+namespace rtcost {
+
+std::size_t KindCounts::total() const {
+    std::size_t n = 0;
+    for (std::size_t r : rays) n += r;
+    return n;
+}
+
+float ao_length(const Scene& scene) { return 0.05f * length(scene.bounds().extent()); }
+
+float spawn_offset(const Scene& scene) {
+    float diag = length(scene.bounds().extent());
+    return diag > 0 ? 1e-5f * diag : 1e-5f;
+}
+
+namespace detail {
+
+WhittedTracer::WhittedTracer(const Hierarchy& h, int max_depth)
+    : scene_(h.scene()), h_(h), max_depth_(max_depth), eps_(spawn_offset(h.scene())),
+      light_scale_(h.scene().lights.empty() ? 1.0f : 1.0f / std::sqrt(static_cast<float>(h.scene().lights.size()))) {}
+
+bool WhittedTracer::surface(const Ray& ray, Hit& hit, Surface& s) const {
+    if (!hit.hit()) return false;
+    scene_.complete_hit(ray, hit);
+    s.dir = normalize(ray.d);
+    s.p = ray.o + ray.d * hit.t;
+    s.front = dot(hit.ng, s.dir) < 0;
+    s.n = s.front ? hit.ng : -hit.ng;
+    s.m = &scene_.materials[scene_.prims[hit.prim].material];
+    return true;
+}
+
+Vec3 WhittedTracer::trace(const Ray& ray, RayKind kind, int depth, Recorder* rec) const {
+    Hit hit;
+    h_.closest(ray, hit);
+    if (rec) rec->add(ray, kind, hit.hit());
+    Surface s;
+    if (!surface(ray, hit, s)) return scene_.background;
+    const Material& m = *s.m;
+
+    Vec3 color = m.color * (kAmbient * m.kd);
+    const Vec3 refl = s.dir - s.n * (2 * dot(s.dir, s.n));
+    for (const Light& light : scene_.lights) {
+        // No shadow ray when the light is behind the surface as the ray sees it.
+        Vec3 o = s.p + s.n * eps_;
+        Vec3 to_light = light.position - o;
+        if (!(dot(s.n, to_light) > 0)) continue;
+        Ray shadow{o, to_light, 0, 1};
+        Hit sh;
+        bool blocked = h_.any(shadow, sh);
+        if (rec) rec->add(shadow, RayKind::Shadow, blocked);
+        if (blocked) continue;
+        Vec3 l = normalize(to_light);
+        Vec3 lc = light.color * light_scale_;
+        color += m.color * lc * (m.kd * dot(s.n, l));
+        float rl = dot(refl, l);
+        if (m.ks > 0 && rl > 0) color += lc * (m.ks * std::pow(rl, m.shine));
+    }
+    if (depth >= max_depth_) return color;
+
+    // Transmitters reflect too (their Ks may be 0): the published SPD counts include those rays.
+    bool reflect = m.ks > 0 || m.t > 0, refract = m.t > 0;
+    float reflect_weight = m.ks;
+    Vec3 refr;
+    if (refract) {
+        // Entering through the side the geometric normal points to, leaving through the other.
+        float ior = m.ior > 0 ? m.ior : 1.0f;
+        float eta = s.front ? 1.0f / ior : ior;
+        float cos_i = -dot(s.dir, s.n);
+        float k = 1 - eta * eta * (1 - cos_i * cos_i);
+        if (k < 0) {  // total internal reflection: the transmitted part reflects
+            refract = false;
+            reflect = true;
+            reflect_weight += m.t;
+        } else {
+            refr = normalize(s.dir * eta + s.n * (eta * cos_i - std::sqrt(k)));
+        }
+    }
+    if (reflect)
+        color += trace(Ray{s.p + s.n * eps_, refl, 0, kInf}, RayKind::Reflection, depth + 1, rec) * reflect_weight;
+    if (refract)
+        color += trace(Ray{s.p - s.n * eps_, refr, 0, kInf}, RayKind::Refraction, depth + 1, rec) * m.t;
+    return color;
+}
+
+void run_rows(int rows, int threads, const std::function<void(int)>& row,
+              const std::function<void(std::size_t)>& progress) {
+    tbb::task_arena arena(threads > 0 ? threads : default_threads());
+    std::atomic<std::size_t> done{0};
+    std::mutex mutex;
+    arena.execute([&] {
+        tbb::parallel_for(tbb::blocked_range<int>(0, rows, 1), [&](const tbb::blocked_range<int>& r) {
+            for (int j = r.begin(); j != r.end(); ++j) row(j);
+            std::size_t d = done.fetch_add(r.size()) + r.size();
+            if (progress) {
+                std::lock_guard lock(mutex);
+                progress(d);
+            }
+        });
+    });
+}
+
+}  // namespace detail
+
+namespace {
+
+using detail::Recorder;
+
+// Rows recorded apart (in parallel) and joined in row order, so the result never depends on
+// the threads.
+RayTree join(std::vector<Recorder>& rows, bool record) {
+    RayTree tree;
+    std::size_t n = 0;
+    for (const Recorder& r : rows) {
+        n += r.rays.size();
+        for (int k = 0; k < kRayKinds; ++k) {
+            tree.counts.rays[k] += r.counts.rays[k];
+            tree.counts.hits[k] += r.counts.hits[k];
+        }
+    }
+    if (!record) return tree;
+    tree.rays.reserve(n);
+    tree.kinds.reserve(n);
+    for (Recorder& r : rows) {
+        tree.rays.insert(tree.rays.end(), r.rays.begin(), r.rays.end());
+        tree.kinds.insert(tree.kinds.end(), r.kinds.begin(), r.kinds.end());
+        r = Recorder{};  // free as we go: the full SPD tree is ~100 MB
+    }
+    return tree;
+}
+
+// splitmix64 (Steele, Lea and Flood): a tiny, well-mixed generator whose whole state is one
+// word, so every pixel gets its own stream from (seed, pixel) independently of the threads.
+struct PixelRng {
+    std::uint64_t state;
+    PixelRng(std::uint64_t seed, std::uint64_t pixel) : state(seed * 0x9e3779b97f4a7c15ull ^ (pixel + 1) * 0xd1b54a32d192ed03ull) {
+        next();
+    }
+    std::uint64_t next() {
+        std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
+        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
+        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
+        return z ^ (z >> 31);
+    }
+    double uniform() { return static_cast<double>(next() >> 11) * 0x1p-53; }
+};
+
+// Cosine-weighted direction about unit `n` (Malley's method: uniform on the disc, projected up).
+Vec3 cosine_direction(Vec3 n, PixelRng& rng) {
+    double u1 = rng.uniform(), u2 = rng.uniform();
+    double r = std::sqrt(u1), phi = 2 * std::numbers::pi * u2;
+    Vec3 a = std::fabs(n.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    Vec3 t = normalize(cross(n, a));
+    Vec3 b = cross(n, t);
+    Vec3 d = t * static_cast<float>(r * std::cos(phi)) + b * static_cast<float>(r * std::sin(phi)) +
+             n * static_cast<float>(std::sqrt(std::max(0.0, 1 - u1)));
+    return normalize(d);
+}
+
+}  // namespace
+
+RayTree whitted_tree(const Hierarchy& h, const WhittedOptions& opt) {
+    const Scene& scene = h.scene();
+    const std::vector<Ray> eye = camera_rays(scene.camera, opt.width, opt.height);
+    detail::WhittedTracer tracer(h, opt.max_depth);
+    std::vector<Recorder> rows(static_cast<std::size_t>(opt.height));
+    detail::run_rows(
+        opt.height, opt.threads,
+        [&](int j) {
+            Recorder& rec = rows[j];
+            rec.keep = opt.record;
+            for (int i = 0; i < opt.width; ++i)
+                tracer.trace(eye[static_cast<std::size_t>(j) * opt.width + i], RayKind::Eye, 1, &rec);
+        },
+        opt.progress);
+    return join(rows, opt.record);
+}
+
+RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int height, std::uint64_t seed,
+                        int threads, const std::function<void(std::size_t)>& progress) {
+    const Scene& scene = h.scene();
+    const std::vector<Ray> eye = camera_rays(scene.camera, width, height);
+    detail::WhittedTracer tracer(h, 1);
+    const float eps = spawn_offset(scene), ao = ao_length(scene);
+    std::vector<Recorder> rows(static_cast<std::size_t>(height));
+    detail::run_rows(
+        height, threads,
+        [&](int j) {
+            Recorder& rec = rows[j];
+            for (int i = 0; i < width; ++i) {
+                const std::size_t pixel = static_cast<std::size_t>(j) * width + i;
+                const Ray& ray = eye[pixel];
+                Hit hit;
+                h.closest(ray, hit);
+                rec.count(RayKind::Eye, hit.hit());
+                detail::Surface s;
+                if (!tracer.surface(ray, hit, s)) continue;
+                if (which == CameraHitRays::Shadow) {
+                    Vec3 o = s.p + s.n * eps;
+                    for (const Light& light : scene.lights) {
+                        Vec3 to_light = light.position - o;
+                        if (!(dot(s.n, to_light) > 0)) continue;
+                        Ray r{o, to_light, 0, 1};
+                        Hit sh;
+                        rec.add(r, RayKind::Shadow, h.any(r, sh));
+                    }
+                    continue;
+                }
+                PixelRng rng(seed, pixel);
+                Ray r{s.p + s.n * eps, cosine_direction(s.n, rng), 0, kInf};
+                Hit sh;
+                if (which == CameraHitRays::Diffuse) {
+                    h.closest(r, sh);
+                    rec.add(r, RayKind::Diffuse, sh.hit());
+                } else {
+                    r.tmax = ao;
+                    rec.add(r, RayKind::AO, h.any(r, sh));
+                }
+            }
+        },
+        progress);
+    return join(rows, true);
+}
+
+bool is_tree_distribution(const std::string& name) {
+    return name == "spd" || name == "shadow" || name == "diffuse" || name == "ao";
+}
+
+RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, int threads,
+                      const std::function<void(std::size_t, std::size_t)>& progress) {
+    if (!is_tree_distribution(spec.name)) throw InputError(spec.name, 0, "not a ray tree distribution");
+    const bool spd = spec.name == "spd";
+    int w = spd ? 512 : scene.camera.width, h = spd ? 512 : scene.camera.height;
+    if (!spec.size.empty()) parse_size(spec.size, "--size", w, h);
+    // Hits are exact, so the rays are the same whichever hierarchy finds them: use a fast one.
+    auto bvh = build_hierarchy(scene, "bvh-sah");
+    const int rows = spd ? h + 1 : h;
+    std::function<void(std::size_t)> rows_done;
+    if (progress) rows_done = [&](std::size_t d) { progress(d, static_cast<std::size_t>(rows)); };
+
+    RayTree tree;
+    std::string described;
+    if (spd) {
+        WhittedOptions opt;
+        opt.width = w + 1;
+        opt.height = h + 1;
+        opt.threads = threads;
+        opt.progress = rows_done;
+        tree = whitted_tree(*bvh, opt);
+        described = fmt::format("spd {}x{} ({}x{} corner eye rays, depth 5)", w, h, w + 1, h + 1);
+    } else {
+        CameraHitRays which = spec.name == "shadow"    ? CameraHitRays::Shadow
+                              : spec.name == "diffuse" ? CameraHitRays::Diffuse
+                                                       : CameraHitRays::AO;
+        tree = camera_hit_rays(*bvh, which, w, h, spec.seed, threads, rows_done);
+        described = which == CameraHitRays::Shadow ? fmt::format("shadow rays of camera {}x{} hits", w, h)
+                                                   : fmt::format("{} rays of camera {}x{} hits seed {}", spec.name, w, h,
+                                                                 spec.seed);
+    }
+    RaySet set;
+    set.rays = std::move(tree.rays);
+    set.kinds = std::move(tree.kinds);
+    set.described = std::move(described);
+    for (int k = 0; k < kRayKinds; ++k) {
+        RayKind kind = static_cast<RayKind>(k);
+        bool listed = kind == RayKind::Eye || (spd && (kind == RayKind::Reflection || kind == RayKind::Refraction ||
+                                                       kind == RayKind::Shadow));
+        if (!listed && tree.counts.rays[k] == 0) continue;
+        // Camera rays only seed the other sets and are not in them: say so by the name.
+        std::string name(!spd && kind == RayKind::Eye ? "camera" : ray_kind_name(kind));
+        set.summary.push_back({name, tree.counts.rays[k]});
+        set.summary.push_back({name + "_hits", tree.counts.hits[k]});
+    }
+    return set;
+}
+
+}  // namespace rtcost

@@ -1,0 +1,59 @@
+#pragma once
+// The Whitted recursion shared by the SPD ray tree (which records rays) and the renderer (which
+// keeps the colour): one code path, so the image shows exactly the rays that are counted.
+#include <functional>
+#include <vector>
+
+#include "rtcost/whitted.hpp"
+
+namespace rtcost::detail {
+
+/// Rays of one image row (or any run of pixels), with counts by kind.
+struct Recorder {
+    bool keep = true;
+    std::vector<Ray> rays;
+    std::vector<RayKind> kinds;
+    KindCounts counts;
+    void count(RayKind k, bool hit) {
+        ++counts.rays[static_cast<int>(k)];
+        counts.hits[static_cast<int>(k)] += hit;
+    }
+    void add(const Ray& r, RayKind k, bool hit) {
+        count(k, hit);
+        if (!keep) return;
+        rays.push_back(r);
+        kinds.push_back(k);
+    }
+};
+
+/// A hit point as shading sees it.
+struct Surface {
+    Vec3 p;       ///< the point
+    Vec3 dir;     ///< unit direction of the incoming ray
+    Vec3 n;       ///< unit normal facing the incoming ray
+    bool front;   ///< the ray met the side the geometric normal points to
+    const Material* m;
+};
+
+class WhittedTracer {
+public:
+    WhittedTracer(const Hierarchy& h, int max_depth);
+    /// Colour seen along `ray` of depth `depth` (eye ray: 1); records every ray spawned in `rec`.
+    Vec3 trace(const Ray& ray, RayKind kind, int depth, Recorder* rec) const;
+    /// Fills `s` for a hit of `ray` (completing `hit`'s normal); false on a miss.
+    bool surface(const Ray& ray, Hit& hit, Surface& s) const;
+
+private:
+    static constexpr float kAmbient = 0.15f;
+    const Scene& scene_;
+    const Hierarchy& h_;
+    int max_depth_;
+    float eps_;
+    float light_scale_;
+};
+
+/// Calls row(j) for every j in [0, rows) on `threads` threads (0: all cores), reporting rows done.
+void run_rows(int rows, int threads, const std::function<void(int)>& row,
+              const std::function<void(std::size_t)>& progress);
+
+}  // namespace rtcost::detail
