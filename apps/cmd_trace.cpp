@@ -86,7 +86,7 @@ int cmd_trace(const TraceArgs& a, const Common& common) {
     if (counted) {
         auto line = [](const char* label, const RayCounters& c) {
             double n = c.rays ? static_cast<double>(c.rays) : 1;
-            fmt::print("{:<10} N_IT {:.2f}  N_TS {:.2f}  N_ETS {:.2f}  N_EETS {:.2f}  box {:.2f}  plane {:.2f}  hop "
+            fmt::print("{:<13} N_IT {:.2f}  N_TS {:.2f}  N_ETS {:.2f}  N_EETS {:.2f}  box {:.2f}  plane {:.2f}  hop "
                        "{:.2f}  classify {:.2f}\n",
                        label, c.prim_tests() / n, c.steps / n, c.leaves / n, c.empty_leaves / n, c.box / n,
                        c.plane / n, c.hop / n, c.classify / n);
