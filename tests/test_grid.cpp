@@ -370,14 +370,9 @@ const std::vector<std::vector<std::string>> kGridVariants = {
 };
 
 void expect_matches_brute(const Scene& s, const std::vector<Ray>& rays, const std::string& what) {
-    auto brute = build_hierarchy(s, "brute");
-    std::vector<Hit> want = closest_hits(*brute, rays);
-    for (const auto& set : kGridVariants) {
-        auto g = build_hierarchy(s, "grid", set);
-        std::string first;
-        EXPECT_EQ(count_mismatches(want, closest_hits(*g, rays), 0.0f, &first), 0u)
-            << what << " " << ::testing::PrintToString(set) << ": " << first;
-    }
+    std::vector<Variant> variants;
+    for (const auto& set : kGridVariants) variants.emplace_back("grid", set);
+    expect_variants_match_brute(s, rays, what, variants);
 }
 
 TEST(GridTrace, MatchesBruteForceOnBuiltinScenes) {

@@ -112,6 +112,22 @@ inline std::size_t count_mismatches(std::span<const Hit> want, std::span<const H
     return bad;
 }
 
+/// A hierarchy to build: its name and its `--set` assignments.
+using Variant = std::pair<std::string, std::vector<std::string>>;
+
+/// Every variant returns exactly brute force's closest hits for `rays` (ties at shared edges aside).
+inline void expect_variants_match_brute(const Scene& s, std::span<const Ray> rays, const std::string& what,
+                                        const std::vector<Variant>& variants) {
+    auto brute = build_hierarchy(s, "brute");
+    std::vector<Hit> want = closest_hits(*brute, rays);
+    for (const auto& [name, set] : variants) {
+        auto h = build_hierarchy(s, name, set);
+        std::string first;
+        EXPECT_EQ(count_mismatches(want, closest_hits(*h, rays), 0.0f, &first), 0u)
+            << what << " " << name << " " << ::testing::PrintToString(set) << ": " << first;
+    }
+}
+
 struct Measured {
     double mean = 0, se = 0;  // scalar cost per ray and its standard error
     CostVector by_kind;

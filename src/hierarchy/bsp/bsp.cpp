@@ -1,0 +1,144 @@
+// `bsp`: the build, structure statistics, the model tree and the registration.
+#include "bsp.hpp"
+
+#include <algorithm>
+
+namespace rtcost::bsp {
+
+Bsp::Bsp(const Scene& s, const Options& o) : HierarchyImpl(s), o_(o), root_(s.bounds()) {
+    const bool empty = s.empty() || root_.empty();
+    if (empty) root_ = Box3{{0, 0, 0}, {0, 0, 0}};
+    const subdiv::Assigner as(s, o.assign);
+    std::vector<std::uint32_t> refs = empty ? std::vector<std::uint32_t>{} : as.all();
+    nodes_.emplace_back();
+    build(0, root_, 0, refs, as);
+    nodes_.shrink_to_fit();
+    refs_.shrink_to_fit();
+}
+
+void Bsp::make_leaf(std::uint32_t node, const std::vector<std::uint32_t>& refs) {
+    Node& n = nodes_[node];
+    n.axis = 3;
+    n.index = static_cast<std::uint32_t>(refs_.size());
+    n.count = static_cast<std::uint32_t>(refs.size());
+    refs_.insert(refs_.end(), refs.begin(), refs.end());
+}
+
+// Recursion depth is at most max_depth <= kMaxDepth.
+void Bsp::build(std::uint32_t node, const Box3& cell, int depth, std::vector<std::uint32_t>& refs,
+                const subdiv::Assigner& as) {
+    if (refs.size() <= static_cast<std::size_t>(o_.max_prims) || depth >= o_.max_depth ||
+        refs_.size() >= subdiv::kMaxRefs || nodes_.size() >= subdiv::kMaxNodes)
+        return make_leaf(node, refs);
+    // At the top of each block of three levels (X, Y, Z: the block ends in the cell's octants,
+    // the very cells an octree node makes), the growth guard: the references straddle so much
+    // that the block would hardly separate them.
+    if (depth % 3 == 0 && o_.growth < 9) {
+        Box3 oct[8];
+        const Vec3 c{subdiv::mid(cell.lo.x, cell.hi.x), subdiv::mid(cell.lo.y, cell.hi.y),
+                     subdiv::mid(cell.lo.z, cell.hi.z)};
+        for (int k = 0; k < 8; ++k) oct[k] = subdiv::octant(cell, c, k);
+        std::vector<std::uint8_t> omask;
+        std::array<std::size_t, 8> ocounts;
+        as.masks(refs, oct, 8, omask, ocounts);
+        std::size_t sum = 0;
+        for (std::size_t n : ocounts) sum += n;
+        if (static_cast<double>(sum) >= o_.growth * static_cast<double>(refs.size())) return make_leaf(node, refs);
+    }
+    const int a = depth % 3;
+    const float s = subdiv::mid(cell.lo[a], cell.hi[a]);
+    const Box3 halves[2] = {subdiv::half(cell, a, s, 0), subdiv::half(cell, a, s, 1)};
+    std::vector<std::uint8_t> mask;
+    std::array<std::size_t, 8> counts;
+    as.masks(refs, halves, 2, mask, counts);
+    std::vector<std::uint32_t> lo = subdiv::Assigner::select(refs, mask, 0, counts[0]);
+    std::vector<std::uint32_t> hi = subdiv::Assigner::select(refs, mask, 1, counts[1]);
+    std::vector<std::uint32_t>().swap(refs);  // free the parent's list before descending
+    const std::uint32_t first = static_cast<std::uint32_t>(nodes_.size());
+    nodes_.resize(nodes_.size() + 2);
+    Node& n = nodes_[node];
+    n.axis = static_cast<std::uint32_t>(a);
+    n.split = s;
+    n.index = first;
+    n.count = 0;
+    build(first, halves[0], depth + 1, lo, as);
+    build(first + 1, halves[1], depth + 1, hi, as);
+}
+
+StructureStats Bsp::compute_structure() const {
+    StructureStats s;
+    std::vector<int> depth(nodes_.size(), 0);  // children always follow their parent
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+        const Node& n = nodes_[i];
+        if (n.leaf()) {
+            ++s.leaves;
+            s.empty_leaves += n.count == 0;
+            s.references += n.count;
+            s.depth = std::max(s.depth, depth[i]);
+        } else {
+            ++s.interior;
+            depth[n.index] = depth[n.index + 1] = depth[i] + 1;
+        }
+    }
+    s.bytes = nodes_.size() * sizeof(Node) + refs_.size() * sizeof(std::uint32_t);
+    return s;
+}
+
+// One model node per BSP node (same indices): a visit costs one plane compare and is one step;
+// with `locate` the model charges every leaf visit its whole descent again.
+ModelTree Bsp::model_tree() const {
+    ModelTree t;
+    t.family = "bsp";
+    t.locate = o_.locate;
+    t.per_ray_box = 1;
+    t.prims = refs_;
+    t.nodes.resize(nodes_.size());
+    t.nodes[0].region = root_;
+    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+        const Node& n = nodes_[i];
+        ModelNode& m = t.nodes[i];
+        m.first = n.index;
+        m.leaf = n.leaf();
+        m.step = true;
+        if (n.leaf()) {
+            m.count = n.count;
+            continue;
+        }
+        const int a = static_cast<int>(n.axis);
+        m.count = 2;
+        m.axis = static_cast<std::int8_t>(a);
+        m.split = n.split;
+        m.plane = 1;
+        for (int side = 0; side < 2; ++side) {
+            ModelNode& c = t.nodes[n.index + side];
+            c.region = subdiv::half(m.region, a, n.split, side);
+            c.depth = m.depth + 1;
+        }
+    }
+    return t;
+}
+
+namespace {
+
+const Registration reg{
+    {"bsp",
+     "Kaplan's BSP tree: binary, spatial mid-plane, axes X, Y, Z in turn",
+     {{"max_depth", "20", "deepest leaf (root at 0; at most 60)"},
+      {"max_prims", "2", "a node with at most this many references is a leaf"},
+      subdiv::kTraversalParam,
+      spatial::kAssignParam,
+      subdiv::kGrowthParam,
+      spatial::kMailboxParam},
+     [](const Scene& s, const Params& p) {
+         Options o;
+         o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
+         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
+         o.locate = p.choice("traversal", {"locate", "recursive"}) == "locate";
+         o.assign = spatial::parse_assign(p);
+         o.mailbox = p.flag("mailbox");
+         o.growth = p.real("growth", 1, 9);
+         return std::make_unique<Bsp>(s, o);
+     }}};
+
+}  // namespace
+}  // namespace rtcost::bsp
