@@ -157,8 +157,6 @@ int cmd_eval(EvalArgs& a, const Common& common) {
     };
 
     std::vector<EvalRow> rows;
-    std::array<std::vector<Hit>, kRayKinds> train_hits;
-    bool have_train_hits = false;
     Progress progress("eval", names.size(), common.quiet || common.json);
     for (const auto& name : names) {
         auto h = build(scene, BuildArgs{a.scene, name, a.set}, common);
@@ -182,11 +180,6 @@ int cmd_eval(EvalArgs& a, const Common& common) {
         ModelTree tree = h->model_tree();
         row.modelled = !tree.nodes.empty();
         if (row.modelled) {
-            if (sampled && !have_train_hits) {
-                // Closest hits are exact in every hierarchy: computed once, with the first.
-                for (int k = 0; k < kRayKinds; ++k) train_hits[k] = trace_rays(*h, train_kinds[k]).hits;
-                have_train_hits = true;
-            }
             for (const std::string& est : estimators) {
                 for (const std::string& preset : presets) {
                     std::vector<std::pair<double, Prediction>> parts;
@@ -199,8 +192,7 @@ int cmd_eval(EvalArgs& a, const Common& common) {
                         if (est == "sampled" && train_kinds[k].empty())
                             throw InputError("--sample", 0, "no training rays of kind " +
                                                                 std::string(ray_kind_name(static_cast<RayKind>(k))));
-                        parts.emplace_back(share, est == "sampled" ? predict_sampled(tree, scene, train_kinds[k],
-                                                                                     train_hits[k], o, costs)
+                        parts.emplace_back(share, est == "sampled" ? predict_sampled(tree, scene, train_kinds[k], o, costs)
                                                                    : predict_geometric(tree, scene, o, costs));
                     }
                     row.preds.push_back(mix(parts, costs));

@@ -43,16 +43,60 @@ TEST(ModelSampled, Rc5dOrderedSearchOnCameraRays) {
     auto rays = camera_rays(s.camera, 128, 128);
     std::vector<Ray> train, test;
     for (std::size_t i = 0; i < rays.size(); ++i) (i % 2 ? train : test).push_back(rays[i]);
-    auto hits = trace_rays(*h, train).hits;
     ModelOptions closest;
-    Prediction ps = predict_sampled(h->model_tree(), s, train, hits, closest);
+    Prediction ps = predict_sampled(h->model_tree(), s, train, closest);
     Measured m = measure_all(*h, test, UnitCosts{}, Query::Closest);
     EXPECT_NEAR(ps.scalar, m.mean, 0.05 * m.mean) << "sampled " << ps.scalar << " measured " << m.mean;
     EXPECT_NEAR(ps.cost.classify, m.by_kind.classify, 0.05 * m.by_kind.classify);
     // Without termination every candidate counts, so closest hits cost less.
     ModelOptions all;
     all.query = Query::All;
-    EXPECT_LT(ps.scalar, predict_sampled(h->model_tree(), s, train, hits, all).scalar);
+    EXPECT_LT(ps.scalar, predict_sampled(h->model_tree(), s, train, all).scalar);
+}
+
+// The sampled estimator's probe walks the model tree as the traversal does, so on its own
+// training rays the recursion must give back the traversal's counts, kind by kind, for every
+// hierarchy and every query. (Any residue is a node or an ending the model misses.)
+TEST(ModelSampled, ReproducesTheTrainingRaysCountsForEveryHierarchyAndQuery) {
+    Scene s = builtin_scene("balls", 2);
+    std::vector<Ray> rays = camera_rays(s.camera, 48, 48);
+    std::vector<Ray> more = random_rays(s.bounds(), 3000, 21);
+    rays.insert(rays.end(), more.begin(), more.end());
+    const std::vector<Variant> variants = {
+        {"bvh-median", {}},   {"bvh-gs", {}},       {"bvh-sah", {}},      {"bvh-sah", {"order=none"}},
+        {"kd-median", {}},    {"kd-sah", {}},       {"grid", {}},         {"grid", {"res=woo"}},
+        {"bsp", {}},          {"bsp", {"traversal=recursive"}},           {"octree", {}},
+        {"octree", {"traversal=recursive", "max_prims=2"}},               {"rc5d", {"build=eager", "max_depth=10"}},
+    };
+    for (const auto& [name, set] : variants) {
+        auto h = build_hierarchy(s, name, set);
+        ModelTree t = h->model_tree();
+        for (Query q : {Query::Closest, Query::Any, Query::All}) {
+            RayCounters total;
+            for (const Ray& r : rays) {
+                Hit hit;
+                if (q == Query::Closest) h->closest(r, hit, total);
+                else if (q == Query::Any) h->any(r, hit, total);
+                else h->all(r, hit, total);
+            }
+            const CostVector m = measured_cost(total);
+            ModelOptions o;
+            o.query = q;
+            const Prediction p = predict_sampled(t, s, rays, o);
+            const std::string what = name + " " + ::testing::PrintToString(set) + " query " +
+                                     std::to_string(static_cast<int>(q));
+            auto near = [&](double pred, double meas, const char* kind) {
+                EXPECT_NEAR(pred, meas, 1e-3 * meas + 1e-9) << what << " " << kind;
+            };
+            near(p.cost.box, m.box, "box");
+            near(p.cost.plane, m.plane, "plane");
+            near(p.cost.hop, m.hop, "hop");
+            near(p.cost.classify, m.classify, "classify");
+            near(p.cost.prim_tests(), m.prim_tests(), "prim");
+            near(p.cost.steps, m.steps, "steps");
+            near(p.cost.leaves, m.leaves, "leaves");
+        }
+    }
 }
 
 TEST(ModelExactness, BruteForceIsEveryPrimitive) {
@@ -92,8 +136,7 @@ TEST(ModelTermination, ClosestHitCostsLessThanAllHitsAndSampledIsClose) {
     auto rays = camera_rays(s.camera, 128, 128);
     std::vector<Ray> train, test;
     for (std::size_t i = 0; i < rays.size(); ++i) (i % 2 ? train : test).push_back(rays[i]);
-    auto hits = trace_rays(*h, train).hits;
-    Prediction ps = predict_sampled(t, s, train, hits, closest);
+    Prediction ps = predict_sampled(t, s, train, closest);
     Measured m = measure_all(*h, test, UnitCosts{}, Query::Closest);
     double err = (ps.scalar - m.mean) / m.mean;
     EXPECT_LT(std::fabs(err), 0.15) << "sampled " << ps.scalar << " measured " << m.mean;
@@ -101,8 +144,7 @@ TEST(ModelTermination, ClosestHitCostsLessThanAllHitsAndSampledIsClose) {
     // Sampled with no termination on lines is exact in expectation as well.
     auto lines = line_rays(s.bounds(), 50000, 3);
     auto train_lines = line_rays(s.bounds(), 50000, 4);
-    auto train_hits = trace_rays(*h, train_lines).hits;
-    Prediction psa = predict_sampled(t, s, train_lines, train_hits, all);
+    Prediction psa = predict_sampled(t, s, train_lines, all);
     Measured ma = measure_all(*h, lines, UnitCosts{}, Query::All);
     EXPECT_NEAR(psa.scalar, ma.mean, 0.02 * ma.mean);
 }

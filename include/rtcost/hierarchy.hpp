@@ -70,6 +70,9 @@ struct ModelTree {
     /// are disjoint sets of rays), whose leaf candidates are searched in order of their start
     /// along the dominant axis and the search stops early.
     bool one_path = false;
+    /// A closest-hit query skips what lies beyond the nearest hit found so far (false: the
+    /// traversal visits everything the segment meets, e.g. a BVH with `order=none`).
+    bool cull = true;
     std::vector<ModelNode> nodes;
     std::vector<std::uint32_t> prims;  ///< leaf primitive references
 };

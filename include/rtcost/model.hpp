@@ -95,6 +95,10 @@ struct NodeProbabilities {
     /// with this node first (sampled estimator; negative: use p_hit).
     float p_first = -1;
     float p_bv = 1;    ///< the segment meets the node's bounding volume (when it has one)
+    /// A child of a node with more than two children: the share of the parent's visits that
+    /// entered it, counted by the sampled estimator's probe (negative: from `handed`, P and a
+    /// random order of the siblings).
+    float entered = -1;
     /// Leaves of one-path trees (5D) searched in order: expected candidates tested per visit, by
     /// kind, when the search may stop early.
     bool ordered = false;
@@ -120,10 +124,12 @@ struct Prediction {
 Prediction predict_geometric(const ModelTree& tree, const Scene& scene, const ModelOptions& opt,
                              const UnitCosts& costs = {});
 
-/// Sampled estimator: a probe walk of the model tree with each training ray's true closest hit
-/// fills alpha, beta, gamma, P per node; the recursion then predicts from those ratios.
-/// `closest` holds the training rays' closest hits (from any exact hierarchy).
+/// Sampled estimator: a probe traversal of the model tree with each training ray -- children
+/// front to back, real primitive tests, the query's rule for ending (opt.query) -- fills alpha,
+/// beta, gamma, P and the tests per leaf visit; the recursion then predicts from those ratios.
+/// On the training rays themselves the prediction equals the traversal's counts; on other rays
+/// of the same distribution it errs by the sample's noise.
 Prediction predict_sampled(const ModelTree& tree, const Scene& scene, std::span<const Ray> training,
-                           std::span<const Hit> closest, const ModelOptions& opt, const UnitCosts& costs = {});
+                           const ModelOptions& opt, const UnitCosts& costs = {});
 
 }  // namespace rtcost

@@ -136,12 +136,16 @@ struct Walk {
     }
 };
 
+/// Whether a hit found ends (part of) the search: an any-hit query stops at its first hit; a
+/// closest-hit one skips what lies beyond, unless the traversal visits everything (ModelTree::cull).
+bool terminates(const ModelTree& t, Query q) { return q == Query::Any || (q == Query::Closest && t.cull); }
+
 /// q(child | parent visited) for every node from per-node probabilities (the recursion's
 /// coefficients), then pi and the cost vector.
 Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodeProbabilities>& prob,
                     const Scene& scene, const ModelOptions& opt, const UnitCosts& costs) {
     const std::size_t n = t.nodes.size();
-    const bool terminate = opt.query != Query::All;
+    const bool terminate = terminates(t, opt.query);
     const bool paper = opt.preset == Preset::Paper;
     std::vector<double> pi(n, 0.0);
     pi[0] = 1.0;
@@ -232,6 +236,10 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
             const std::uint32_t k = m.count;
             for (std::uint32_t x = 0; x < k; ++x) {
                 const std::uint32_t cx = m.first + x;
+                if (prob[cx].entered >= 0) {  // sampled: counted, no order to assume
+                    pi[cx] = pg * prob[cx].entered;
+                    continue;
+                }
                 double met_x = prob[cx].handed;  // P(X | parent) stored in `handed`
                 double survive = 1.0;
                 if (terminate && k > 1) {
@@ -392,15 +400,29 @@ Prediction predict_one_path_geometric(const ModelTree& t, const Walk& w, const S
     return p;
 }
 
+/// The share of rays that meet the root: the recursion predicts per ray that does; every ray
+/// still pays the root test.
+void scale_to_share(Prediction& p, const ModelTree& t, double share, const UnitCosts& costs) {
+    CostVector& c = p.cost;
+    c.box -= t.per_ray_box;
+    auto scale = [&](double& v) { v *= share; };
+    scale(c.box); scale(c.plane); scale(c.hop); scale(c.classify);
+    for (auto& v : c.prim) scale(v);
+    scale(c.steps); scale(c.leaves); scale(c.empty_leaves);
+    for (auto& v : p.visits_by_depth) scale(v);
+    c.box += t.per_ray_box;
+    p.scalar = costs.scalar(c);
+}
+
 Prediction predict_one_path_sampled(const ModelTree& t, const Walk& w, const Scene& scene,
-                                    std::span<const Ray> training, std::span<const Hit> closest,
-                                    const ModelOptions& opt, const UnitCosts& costs) {
+                                    std::span<const Ray> training, const ModelOptions& opt, const UnitCosts& costs) {
     const std::size_t n = t.nodes.size();
     std::vector<double> handed(n, 0.0);
     std::vector<std::array<double, kPrimKinds>> tests(n, std::array<double, kPrimKinds>{});
     const Box3& root = t.nodes[0].region;
-    const bool terminate = opt.query != Query::All;
+    const bool terminate = terminates(t, opt.query);
     std::size_t met = 0;
+    NoCount nc;
     for (std::size_t r = 0; r < training.size(); ++r) {
         const Ray& ray = training[r];
         const RayInv ri(ray);
@@ -433,13 +455,17 @@ Prediction predict_one_path_sampled(const ModelTree& t, const Walk& w, const Sce
             if (m.leaf) break;
             node = m.first + (float(x[m.beam_dim]) >= m.split ? 1u : 0u);
         }
+        // The ordered search, with real tests: a candidate starting beyond the nearest hit so
+        // far is not tested (closest), the first hit ends it (any).
         const ModelNode& leaf = t.nodes[node];
         const double so = neg ? -double(ray.o[k]) : double(ray.o[k]);
-        const double stop = closest[r].hit() && terminate ? so + double(closest[r].t) * adk : kInf;
+        Hit hit;
         for (std::uint32_t c = 0; c < leaf.count; ++c) {
             std::uint32_t id = t.prims[leaf.first + c];
+            const double stop = terminate ? so + double(std::min(hit.t, ray.tmax)) * adk : kInf;
             if (forward_start(scene.prim_bounds(id), k, neg) > stop) break;
             tests[node][static_cast<int>(scene.kind(id))] += 1;
+            if (test_prim(scene, id, ray, hit, nc) && terminate && opt.query == Query::Any) break;
         }
     }
     std::vector<NodeProbabilities> prob(n);
@@ -455,20 +481,144 @@ Prediction predict_one_path_sampled(const ModelTree& t, const Walk& w, const Sce
     }
     Prediction p = evaluate(t, w, prob, scene, opt, costs);
     p.estimator = "sampled";
-    p.note = "5D: path probabilities and ordered-search lengths from " + std::to_string(training.size()) +
-             " training rays";
-    double share = training.empty() ? 0.0 : double(met) / double(training.size());
-    CostVector& c = p.cost;
-    c.box -= t.per_ray_box;
-    auto scale = [&](double& v) { v *= share; };
-    scale(c.box); scale(c.plane); scale(c.hop); scale(c.classify);
-    for (auto& v : c.prim) scale(v);
-    scale(c.steps); scale(c.leaves); scale(c.empty_leaves);
-    for (auto& v : p.visits_by_depth) scale(v);
-    c.box += t.per_ray_box;
-    p.scalar = costs.scalar(c);
+    p.note = "5D: path probabilities and ordered-search lengths from a probe traversal of " +
+             std::to_string(training.size()) + " training rays";
+    scale_to_share(p, t, training.empty() ? 0.0 : double(met) / double(training.size()), costs);
     return p;
 }
+
+/// A segment of a ray by its parameter, [t0, t1]; empty when t0 > t1 (or NaN).
+struct Seg {
+    float t0, t1;
+    bool empty() const { return !(t0 <= t1); }
+};
+
+Seg clip(const RayInv& ri, const Box3& b, Seg s) {
+    for (int k = 0; k < 3; ++k) {
+        float tn = (b.lo[k] - ri.o[k]) * ri.inv[k], tf = (b.hi[k] - ri.o[k]) * ri.inv[k];
+        if (tn > tf) std::swap(tn, tf);
+        // NaN (0 * inf: a ray in a face's plane) fails both compares and is ignored.
+        s.t0 = tn > s.t0 ? tn : s.t0;
+        s.t1 = tf < s.t1 ? tf : s.t1;
+    }
+    return s;
+}
+
+/// The sampled estimator's probe traversal: walks the model tree with each training ray the way
+/// the hierarchy's traversal does -- children front to back, real primitive tests, the query's
+/// rule for ending -- and tallies per node what the recursion's coefficients are made of. The
+/// recursion then reproduces the training rays' operation counts; its error on other rays is
+/// that of the sample.
+class Probe {
+public:
+    struct Tally {
+        double handed = 0, gated = 0;                  // segments handed to the node; past its BV
+        double left = 0, right = 0, both = 0, left_first = 0;  // a two-child node's children met
+        double ended = 0;                              // visits after which nothing beyond was searched
+        double first = 0, first_ends = 0;              // visited first of two met; and that ended it
+        std::array<double, kPrimKinds> tests{};        // primitive tests in a leaf's visits
+    };
+
+    Probe(const ModelTree& t, const Scene& s, Query q)
+        : t_(t), s_(s), any_(q == Query::Any), cull_(q == Query::Closest && t.cull), tally_(t.nodes.size()) {}
+
+    /// One training ray; false when it misses the root.
+    bool run(const Ray& ray) {
+        ray_ = &ray;
+        ri_ = RayInv(ray);
+        hit_ = Hit{};
+        found_ = false;
+        const Seg root = clip(ri_, t_.nodes[0].region, Seg{ray.tmin, ray.tmax});
+        if (root.empty()) return false;
+        visit(0, root);
+        return true;
+    }
+
+    const std::vector<Tally>& tally() const { return tally_; }
+
+private:
+    // Nothing more is searched: an any-hit query has its hit.
+    bool done() const { return any_ && found_; }
+    // A closest-hit traversal skips a segment that starts at or beyond the nearest hit so far.
+    bool beyond(const Seg& s) const { return cull_ && s.t0 >= hit_.t; }
+    // A child's segment, cut at the nearest hit so far when the traversal culls by it.
+    Seg child(std::uint32_t c, const Seg& s) const {
+        Seg x = clip(ri_, t_.nodes[c].region, s);
+        if (cull_ && hit_.t < x.t1) x.t1 = hit_.t;
+        return x;
+    }
+
+    void visit(std::uint32_t node, Seg s) {
+        const ModelNode& m = t_.nodes[node];
+        Tally& ty = tally_[node];
+        ty.handed += 1;
+        if (m.has_bv) {
+            s = clip(ri_, m.bv, s);
+            if (s.empty()) return;
+        }
+        ty.gated += 1;
+        if (m.leaf) {
+            for (std::uint32_t k = 0; k < m.count; ++k) {
+                const std::uint32_t id = t_.prims[m.first + k];
+                ty.tests[static_cast<int>(s_.kind(id))] += 1;
+                if (test_prim(s_, id, *ray_, hit_, nc_)) {
+                    found_ = true;
+                    if (any_) break;
+                }
+            }
+        } else if (m.count == 2) {
+            const Seg sl = child(m.first, s), sr = child(m.first + 1, s);
+            const bool l = !sl.empty(), r = !sr.empty();
+            if (l && r) {
+                ty.both += 1;
+                // Nearer entry first, a tie (a ray starting inside both) to the first child; a
+                // BVH without order: stored order.
+                const bool left_first = !t_.cull || sl.t0 <= sr.t0;
+                ty.left_first += left_first;
+                const std::uint32_t near = left_first ? m.first : m.first + 1;
+                const Seg& far = left_first ? sr : sl;
+                tally_[near].first += 1;
+                visit(near, left_first ? sl : sr);
+                const bool ends = done() || beyond(far);
+                tally_[near].first_ends += ends;
+                if (!ends) visit(left_first ? m.first + 1 : m.first, far);
+            } else if (l) {
+                ty.left += 1;
+                visit(m.first, sl);
+            } else if (r) {
+                ty.right += 1;
+                visit(m.first + 1, sr);
+            }
+        } else {
+            // More children (Goldsmith-Salmon's BVH): those met, nearest entry first.
+            std::array<std::pair<float, std::uint32_t>, 64> met;
+            std::size_t nm = 0;
+            for (std::uint32_t k = 0; k < m.count && nm < met.size(); ++k) {
+                const Seg sc = child(m.first + k, s);
+                if (!sc.empty()) met[nm++] = {sc.t0, m.first + k};
+            }
+            // Ties (a ray starting inside several) go to the later child, as the traversal's sort does.
+            if (t_.cull)
+                std::sort(met.begin(), met.begin() + nm,
+                          [](auto& a, auto& b) { return a.first < b.first || (a.first == b.first && a.second > b.second); });
+            for (std::size_t k = 0; k < nm && !done(); ++k) {
+                const Seg sc = child(met[k].second, s);
+                if (!beyond(sc)) visit(met[k].second, sc);
+            }
+        }
+        ty.ended += done() || (cull_ && hit_.t <= s.t1);
+    }
+
+    const ModelTree& t_;
+    const Scene& s_;
+    const bool any_, cull_;
+    std::vector<Tally> tally_;
+    const Ray* ray_ = nullptr;
+    RayInv ri_{Ray{}};
+    Hit hit_;
+    bool found_ = false;
+    NoCount nc_;
+};
 
 }  // namespace
 
@@ -508,133 +658,30 @@ Prediction predict_geometric(const ModelTree& t, const Scene& scene, const Model
 }
 
 Prediction predict_sampled(const ModelTree& t, const Scene& scene, std::span<const Ray> training,
-                           std::span<const Hit> closest, const ModelOptions& opt, const UnitCosts& costs) {
+                           const ModelOptions& opt, const UnitCosts& costs) {
     if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
     Walk w(t);
-    if (t.one_path) return predict_one_path_sampled(t, w, scene, training, closest, opt, costs);
+    if (t.one_path) return predict_one_path_sampled(t, w, scene, training, opt, costs);
     const std::size_t n = t.nodes.size();
-    // Per-node tallies of the probe walk.
-    struct Tally {
-        double handed = 0, gated = 0, left = 0, right = 0, both = 0, left_first = 0, hit = 0, met = 0;
-        double first = 0, first_ends = 0;  // met both with this node first; and the hit lay in it
-    };
-    std::vector<Tally> tally(n);
-    // P of a node: the ray's closest hit lies within the node's part of the segment. (For
-    // bounding volumes, whose boxes overlap, that hit may belong to a sibling's primitive: an
-    // approximation the model's own independence assumptions already make.)
-    const bool terminate = opt.query != Query::All;
-
-    struct Seg {
-        float t0, t1;
-        bool empty() const { return !(t0 <= t1); }
-    };
-    auto clip = [](const RayInv& ri, const Box3& b, Seg s) {
-        for (int k = 0; k < 3; ++k) {
-            float tn = (b.lo[k] - ri.o[k]) * ri.inv[k], tf = (b.hi[k] - ri.o[k]) * ri.inv[k];
-            if (tn > tf) std::swap(tn, tf);
-            s.t0 = tn > s.t0 ? tn : s.t0;
-            s.t1 = tf < s.t1 ? tf : s.t1;
-        }
-        return s;
-    };
-
-    // Bounding volumes overlap, so a hit inside a BVH node's box may belong to another subtree:
-    // there P counts only hits on the subtree's own primitives (leaves hold disjoint sets).
-    // Space subdivisions: a hit inside the node's part of the segment is one of its primitives.
-    const bool disjoint = t.family == "bvh";
-    std::vector<std::uint32_t> order(n, 0), end(n, 0), leaf_of(disjoint ? scene.size() : 0, 0);
-    if (disjoint) {
-        std::uint32_t next = 0;
-        std::vector<std::pair<std::uint32_t, bool>> dfs{{0, false}};
-        while (!dfs.empty()) {
-            auto [node, done] = dfs.back();
-            dfs.pop_back();
-            if (done) { end[node] = next; continue; }
-            order[node] = next++;
-            dfs.push_back({node, true});
-            const ModelNode& m = t.nodes[node];
-            if (m.leaf) {
-                for (std::uint32_t k = 0; k < m.count; ++k) leaf_of[t.prims[m.first + k]] = node;
-            } else {
-                for (std::uint32_t k = m.count; k-- > 0;) dfs.push_back({m.first + k, false});
-            }
-        }
-    }
-    auto ends_in = [&](std::uint32_t node, Seg s, std::size_t r) {
-        if (!closest[r].hit()) return false;
-        const float th = closest[r].t;
-        if (!(th >= s.t0 && th <= s.t1)) return false;
-        if (!disjoint) return true;
-        std::uint32_t leaf = leaf_of[static_cast<std::uint32_t>(closest[r].prim)];
-        return order[leaf] >= order[node] && order[leaf] < end[node];
-    };
-
-    for (std::size_t r = 0; r < training.size(); ++r) {
-        const Ray& ray = training[r];
-        const RayInv ri(ray);
-        // Explicit stack of (node, segment); children pushed so that the near one is walked first.
-        struct Item { std::uint32_t node; Seg s; };
-        std::vector<Item> stack;
-        Seg root = clip(ri, t.nodes[0].region, Seg{ray.tmin, ray.tmax});
-        if (root.empty()) continue;
-        tally[0].met += 1;
-        stack.push_back({0, root});
-        while (!stack.empty()) {
-            Item it = stack.back();
-            stack.pop_back();
-            const ModelNode& m = t.nodes[it.node];
-            Tally& ty = tally[it.node];
-            ty.handed += 1;
-            Seg s = it.s;
-            if (m.has_bv) {
-                s = clip(ri, m.bv, s);
-                if (s.empty()) continue;
-            }
-            ty.gated += 1;
-            ty.hit += ends_in(it.node, s, r);
-            if (m.leaf) continue;
-            if (m.count == 2) {
-                Seg sl = clip(ri, t.nodes[m.first].region, s), sr = clip(ri, t.nodes[m.first + 1].region, s);
-                bool l = !sl.empty(), rr = !sr.empty();
-                tally[m.first].met += l;
-                tally[m.first + 1].met += rr;
-                if (l && !rr) { ty.left += 1; stack.push_back({m.first, sl}); }
-                if (rr && !l) { ty.right += 1; stack.push_back({m.first + 1, sr}); }
-                if (l && rr) {
-                    ty.both += 1;
-                    bool left_first = sl.t0 < sr.t0 || (sl.t0 == sr.t0 && sl.t1 <= sr.t1);
-                    ty.left_first += left_first;
-                    Item near{left_first ? m.first : m.first + 1, left_first ? sl : sr};
-                    Item far{left_first ? m.first + 1 : m.first, left_first ? sr : sl};
-                    // Bounding volumes overlap: the far child is skipped when the closest hit lies
-                    // before its entry (found in the near child or earlier), not merely in the near box.
-                    bool near_ends = disjoint ? closest[r].hit() && closest[r].t < far.s.t0
-                                              : ends_in(near.node, near.s, r);
-                    tally[near.node].first += 1;
-                    tally[near.node].first_ends += near_ends;
-                    if (!(terminate && near_ends)) stack.push_back(far);
-                    stack.push_back(near);
-                }
-            } else {
-                for (std::uint32_t k = 0; k < m.count; ++k) {
-                    Seg sc = clip(ri, t.nodes[m.first + k].region, s);
-                    if (sc.empty()) continue;
-                    tally[m.first + k].met += 1;
-                    stack.push_back({m.first + k, sc});
-                }
-            }
-        }
-    }
+    Probe probe(t, scene, opt.query);
+    std::size_t met = 0;
+    for (const Ray& ray : training) met += probe.run(ray);
+    const auto& tally = probe.tally();
     std::vector<NodeProbabilities> prob(n);
     for (std::size_t i = 0; i < n; ++i) {
         const ModelNode& m = t.nodes[i];
-        const Tally& ty = tally[i];
+        const Probe::Tally& ty = tally[i];
         NodeProbabilities& q = prob[i];
         q.p_bv = ty.handed > 0 ? ty.gated / ty.handed : 0.0;
-        q.p_hit = ty.gated > 0 ? ty.hit / ty.gated : 0.0;
+        q.p_hit = ty.gated > 0 ? ty.ended / ty.gated : 0.0;
         // P conditioned the way the recursion uses it: this node first, its sibling still ahead.
         if (ty.first > 0) q.p_first = ty.first_ends / ty.first;
-        if (m.leaf) continue;
+        if (m.leaf) {
+            // Tests per visit: all of the leaf's, but an any-hit query stops at its first hit.
+            q.ordered = true;
+            for (int k = 0; k < kPrimKinds; ++k) q.tests[k] = ty.gated > 0 ? ty.tests[k] / ty.gated : 0.0;
+            continue;
+        }
         if (m.count == 2) {
             q.split = true;
             q.alpha = ty.gated > 0 ? ty.left / ty.gated : 0.0;
@@ -642,25 +689,15 @@ Prediction predict_sampled(const ModelTree& t, const Scene& scene, std::span<con
             q.both = ty.gated > 0 ? ty.both / ty.gated : 0.0;
             q.gamma = ty.both > 0 ? ty.left_first / ty.both : 0.5;
         } else {
+            // The probe knows which children were entered after the earlier ones: no order to assume.
             for (std::uint32_t k = 0; k < m.count; ++k)
-                prob[m.first + k].handed = ty.gated > 0 ? tally[m.first + k].met / ty.gated : 0.0;
+                prob[m.first + k].entered = ty.gated > 0 ? tally[m.first + k].handed / ty.gated : 0.0;
         }
     }
     Prediction p = evaluate(t, w, prob, scene, opt, costs);
     p.estimator = "sampled";
-    p.note = "probabilities from " + std::to_string(training.size()) + " training rays";
-    // The root is met by a share of the rays only; the recursion above is per ray that meets it.
-    double met = training.empty() ? 0.0 : tally[0].met / static_cast<double>(training.size());
-    CostVector& c = p.cost;
-    double root_box = t.per_ray_box;
-    auto scale = [&](double& v) { v *= met; };
-    c.box -= root_box;
-    scale(c.box); scale(c.plane); scale(c.hop); scale(c.classify);
-    for (auto& v : c.prim) scale(v);
-    scale(c.steps); scale(c.leaves); scale(c.empty_leaves);
-    for (auto& v : p.visits_by_depth) scale(v);
-    c.box += root_box;
-    p.scalar = costs.scalar(c);
+    p.note = "probabilities from a probe traversal of " + std::to_string(training.size()) + " training rays";
+    scale_to_share(p, t, training.empty() ? 0.0 : static_cast<double>(met) / training.size(), costs);
     return p;
 }
 

@@ -34,6 +34,7 @@ StructureStats Bvh::compute_structure() const {
 ModelTree Bvh::model_tree() const {
     ModelTree t;
     t.family = "bvh";
+    t.cull = ordered_;
     t.nodes.resize(d_.nodes.size());
     t.prims = d_.refs;
     for (std::size_t i = 0; i < d_.nodes.size(); ++i) {
