@@ -110,8 +110,10 @@ int cmd_eval(EvalArgs& a, const Common& common) {
     const bool sampled = std::find(estimators.begin(), estimators.end(), "sampled") != estimators.end();
     RaySet train;
     if (sampled) {
-        // A training sample disjoint from the test rays: a fresh draw for random distributions,
-        // every other ray otherwise (camera rays, ray trees, files).
+        // A training sample disjoint from the test rays: a fresh draw for random distributions;
+        // otherwise (camera rays, ray trees, files) a pseudo-random half of the rays, thinned to
+        // --sample. Not every other ray: a ray tree's order (eye, a shadow ray per light,
+        // reflection, ...) would put one light's shadow rays in training and another's in test.
         if (a.rays.name == "lines" || a.rays.name == "random") {
             RaySpec t = a.rays;
             t.seed = a.rays.seed + 7919;
@@ -119,24 +121,22 @@ int cmd_eval(EvalArgs& a, const Common& common) {
             train = make_rays(scene, t);
         } else {
             RaySet keep;
+            const std::size_t half = test.rays.size() / 2;
+            const double keep_share = half > a.sample ? static_cast<double>(a.sample) / half : 1.0;
             for (std::size_t i = 0; i < test.rays.size(); ++i) {
-                RaySet& to = i % 2 ? train : keep;
+                // splitmix64's finaliser of the index: one bit picks the side, the rest thin.
+                std::uint64_t z = (i + 1) * 0x9E3779B97F4A7C15ull;
+                z = (z ^ (z >> 30)) * 0xBF58476D1CE4E5B9ull;
+                z = (z ^ (z >> 27)) * 0x94D049BB133111EBull;
+                z ^= z >> 31;
+                const bool to_train = z & 1;
+                if (to_train && static_cast<double>(z >> 11) * 0x1.0p-53 >= keep_share) continue;
+                RaySet& to = to_train ? train : keep;
                 to.rays.push_back(test.rays[i]);
                 to.kinds.push_back(test.kinds[i]);
             }
             keep.described = test.described;
             test = std::move(keep);
-            // Every other training ray until the sample size, so each kind keeps its share.
-            if (train.rays.size() > a.sample) {
-                RaySet cut;
-                double stride = static_cast<double>(train.rays.size()) / a.sample;
-                for (std::size_t k = 0; k < a.sample; ++k) {
-                    std::size_t i = static_cast<std::size_t>(k * stride);
-                    cut.rays.push_back(train.rays[i]);
-                    cut.kinds.push_back(train.kinds[i]);
-                }
-                train = std::move(cut);
-            }
         }
     }
     ModelOptions mo;
