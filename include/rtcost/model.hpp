@@ -85,7 +85,6 @@ struct ModelOptions {
 struct NodeProbabilities {
     // Floats: one per node of trees with millions of nodes, and probabilities need no more.
     float handed = 0;  ///< segments handed to the node (sampled) or pi (geometric)
-    bool split = false;  ///< alpha, beta, gamma hold for this two-child node
     float alpha = 0, beta = 0, gamma = 0.5;  ///< left only, right only, left first when both
     /// Both children met: 1 - alpha - beta for a plane split; less for bounding volumes, whose
     /// children need not cover their parent.
@@ -99,11 +98,13 @@ struct NodeProbabilities {
     /// entered it, counted by the sampled estimator's probe (negative: from `handed`, P and a
     /// random order of the siblings).
     float entered = -1;
-    /// Leaves of one-path trees (5D) searched in order: expected candidates tested per visit, by
-    /// kind, when the search may stop early.
+    /// With `ordered`: expected primitive tests per visit of a leaf, by kind, when the search
+    /// may stop inside it (5D candidates searched in order; sampled: an any-hit query's leaves).
+    std::array<float, kPrimKinds> tests{};
     bool ordered = false;
-    std::array<double, kPrimKinds> tests{};
+    bool split = false;  ///< alpha, beta, gamma hold for this two-child node
 };
+static_assert(sizeof(NodeProbabilities) == 56);
 
 /// A prediction: the cost vector, its scalar, and visit probabilities per model depth.
 struct Prediction {

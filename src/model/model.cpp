@@ -182,6 +182,9 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
     };
 
     std::vector<double> e;  // reused: no allocation per node
+    // Primitive kinds in scene order: looking each reference up in scene.prims would miss the cache.
+    std::vector<std::uint8_t> kind(scene.size());
+    for (std::uint32_t id = 0; id < kind.size(); ++id) kind[id] = static_cast<std::uint8_t>(scene.kind(id));
     for (std::size_t i = 0; i < n; ++i) {
         const ModelNode& m = t.nodes[i];
         const NodeProbabilities& q = prob[i];
@@ -201,7 +204,7 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
                 for (int k = 0; k < kPrimKinds; ++k) c.prim[k] += pg * q.tests[k];
             } else {
                 for (std::uint32_t k = 0; k < m.count; ++k)
-                    c.prim[static_cast<int>(scene.kind(t.prims[m.first + k]))] += pg;
+                    c.prim[kind[t.prims[m.first + k]]] += pg;
             }
             if (t.locate) {
                 // Every cell is found by a descent from the root: its ancestors' work again.
@@ -242,7 +245,11 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
                 }
                 double met_x = prob[cx].handed;  // P(X | parent) stored in `handed`
                 double survive = 1.0;
-                if (terminate && k > 1) {
+                if (terminate && k == 2) {
+                    // The other child is before X half the time.
+                    const std::uint32_t y = m.first + (1 - x);
+                    survive = 0.5 * (2 - prob[y].handed * prob[y].p_hit);
+                } else if (terminate && k > 2) {
                     e.assign(k, 0.0);  // e[j]: elementary symmetric polynomial of degree j
                     e[0] = 1;
                     std::uint32_t used = 0;
@@ -275,14 +282,23 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
 
 /// Primitive area inside each node's region, bottom-up (Poisson form of P: 1 - exp(-sum p_i)).
 std::vector<double> area_inside(const ModelTree& t, const Walk& w, const Scene& scene) {
+    // Each primitive's Crofton area and bounds, computed in scene order first: the leaves list
+    // primitives in an order that would make every lookup of their vertices a cache miss.
+    struct PrimGeom {
+        Box3 bounds;
+        float crofton;
+    };
+    std::vector<PrimGeom> geom(scene.size());
+    for (std::uint32_t id = 0; id < geom.size(); ++id)
+        geom[id] = {scene.prim_bounds(id), static_cast<float>(crofton_area(scene, id))};
     const std::size_t n = t.nodes.size();
     std::vector<double> a(n, 0.0);
     for (std::size_t i = n; i-- > 0;) {
         const ModelNode& m = t.nodes[i];
         if (m.leaf) {
             for (std::uint32_t k = 0; k < m.count; ++k) {
-                std::uint32_t id = t.prims[m.first + k];
-                a[i] += crofton_area(scene, id) * share_inside(scene.prim_bounds(id), w.visit_box[i]);
+                const PrimGeom& g = geom[t.prims[m.first + k]];
+                a[i] += g.crofton * share_inside(g.bounds, w.visit_box[i]);
             }
         } else {
             for (std::uint32_t k = 0; k < m.count; ++k) a[i] += a[m.first + k];
