@@ -157,21 +157,22 @@ inline Measured measure_all(const Hierarchy& h, std::span<const Ray> rays, const
 
 /// With isotropic lines, `--query all` and the geometric estimator the model is exact in
 /// expectation: predicted and measured cost agree within three standard errors, in total and by kind.
-inline void expect_model_exact(const Scene& s, const std::string& name, const std::vector<std::string>& set = {}) {
+inline void expect_model_exact(const Scene& s, const std::string& name, const std::vector<std::string>& set = {},
+                               std::size_t n_lines = 200000, double n_se = 3) {
     auto h = build_hierarchy(s, name, set);
     ModelTree t = h->model_tree();
     ASSERT_FALSE(t.nodes.empty()) << name;
     ModelOptions opt;
     opt.query = Query::All;
     Prediction p = predict_geometric(t, s, opt);
-    auto lines = line_rays(s.bounds(), 200000, 11);
+    auto lines = line_rays(s.bounds(), n_lines, 11);
     Measured m = measure_all(*h, lines, UnitCosts{}, Query::All);
-    EXPECT_NEAR(p.scalar, m.mean, 3 * m.se + 1e-9) << name << " predicted " << p.scalar << " measured " << m.mean
+    EXPECT_NEAR(p.scalar, m.mean, n_se * m.se + 1e-9) << name << " predicted " << p.scalar << " measured " << m.mean
                                                    << " se " << m.se;
     // Kind by kind too (same standard error bound is loose but real: kinds are parts of the sum).
-    EXPECT_NEAR(p.cost.box, m.by_kind.box, 3 * m.se + 1e-9) << name;
-    EXPECT_NEAR(p.cost.prim_tests(), m.by_kind.prim_tests(), 3 * m.se + 1e-9) << name;
-    EXPECT_NEAR(p.cost.steps, m.by_kind.steps, 3 * m.se + 1e-9) << name;
+    EXPECT_NEAR(p.cost.box, m.by_kind.box, n_se * m.se + 1e-9) << name;
+    EXPECT_NEAR(p.cost.prim_tests(), m.by_kind.prim_tests(), n_se * m.se + 1e-9) << name;
+    EXPECT_NEAR(p.cost.steps, m.by_kind.steps, n_se * m.se + 1e-9) << name;
 }
 
 }  // namespace rtcost::test
