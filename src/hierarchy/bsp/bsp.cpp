@@ -123,21 +123,9 @@ namespace {
 const Registration reg{
     {"bsp",
      "Kaplan's BSP tree: binary, spatial mid-plane, axes X, Y, Z in turn",
-     {{"max_depth", "20", "deepest leaf (root at 0; at most 60)"},
-      {"max_prims", "2", "a node with at most this many references is a leaf"},
-      subdiv::kTraversalParam,
-      spatial::kAssignParam,
-      subdiv::kGrowthParam,
-      spatial::kMailboxParam},
+     subdiv::param_specs(20, kMaxDepth, 2),
      [](const Scene& s, const Params& p) {
-         Options o;
-         o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
-         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
-         o.locate = p.choice("traversal", {"locate", "recursive"}) == "locate";
-         o.assign = spatial::parse_assign(p);
-         o.mailbox = p.flag("mailbox");
-         o.growth = p.real("growth", 1, 9);
-         return std::make_unique<Bsp>(s, o);
+         return std::make_unique<Bsp>(s, subdiv::read_options<Options>(p, kMaxDepth));
      }}};
 
 }  // namespace

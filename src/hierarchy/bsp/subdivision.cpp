@@ -44,4 +44,14 @@ std::vector<std::uint32_t> Assigner::select(const std::vector<std::uint32_t>& re
     return out;
 }
 
+std::vector<ParamSpec> param_specs(int default_depth, int max_depth, int default_prims) {
+    return {{"max_depth", std::to_string(default_depth),
+             "deepest leaf (root at 0; at most " + std::to_string(max_depth) + ")"},
+            {"max_prims", std::to_string(default_prims), "a node with at most this many references is a leaf"},
+            kTraversalParam,
+            spatial::kAssignParam,
+            kGrowthParam,
+            spatial::kMailboxParam};
+}
+
 }  // namespace rtcost::subdiv

@@ -151,4 +151,20 @@ inline const ParamSpec kGrowthParam{
     "a node stays a leaf when its eight octants would hold at least growth x its references together "
     "(1..9; 8: only when no octant loses one; 9: never)"};
 
+/// The parameters `bsp` and `octree` share, with each one's defaults for depth and leaf size.
+std::vector<ParamSpec> param_specs(int default_depth, int max_depth, int default_prims);
+
+/// Reads those parameters into either's options.
+template <class O>
+O read_options(const Params& p, int max_depth) {
+    O o;
+    o.max_depth = static_cast<int>(p.integer("max_depth", 0, max_depth));
+    o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
+    o.locate = p.choice("traversal", {"locate", "recursive"}) == "locate";
+    o.assign = spatial::parse_assign(p);
+    o.mailbox = p.flag("mailbox");
+    o.growth = p.real("growth", 1, 9);
+    return o;
+}
+
 }  // namespace rtcost::subdiv
