@@ -1,5 +1,6 @@
 // `rtcost eval`: predict each hierarchy's cost with the model, measure it, compare and rank.
 #include <iostream>
+#include <map>
 
 #include "cli.hpp"
 #include "rtcost/model.hpp"
@@ -183,6 +184,8 @@ int cmd_eval(EvalArgs& a, const Common& common) {
             for (const std::string& est : estimators) {
                 for (const std::string& preset : presets) {
                     std::vector<std::pair<double, Prediction>> parts;
+                    // The geometric estimate depends on the query, not on the rays: one per query.
+                    std::map<Query, Prediction> geometric;
                     for (int k = 0; k < kRayKinds; ++k) {
                         if (test_kinds[k].empty()) continue;
                         ModelOptions o = mo;
@@ -192,8 +195,14 @@ int cmd_eval(EvalArgs& a, const Common& common) {
                         if (est == "sampled" && train_kinds[k].empty())
                             throw InputError("--sample", 0, "no training rays of kind " +
                                                                 std::string(ray_kind_name(static_cast<RayKind>(k))));
-                        parts.emplace_back(share, est == "sampled" ? predict_sampled(tree, scene, train_kinds[k], o, costs)
-                                                                   : predict_geometric(tree, scene, o, costs));
+                        if (est == "sampled") {
+                            parts.emplace_back(share, predict_sampled(tree, scene, train_kinds[k], o, costs));
+                        } else {
+                            auto it = geometric.find(o.query);
+                            if (it == geometric.end())
+                                it = geometric.emplace(o.query, predict_geometric(tree, scene, o, costs)).first;
+                            parts.emplace_back(share, it->second);
+                        }
                     }
                     row.preds.push_back(mix(parts, costs));
                 }
