@@ -35,15 +35,12 @@ void Bsp::build(std::uint32_t node, const Box3& cell, int depth, std::vector<std
     // that the block would hardly separate them.
     if (depth % 3 == 0 && o_.growth < 9) {
         Box3 oct[8];
-        const Vec3 c{subdiv::mid(cell.lo.x, cell.hi.x), subdiv::mid(cell.lo.y, cell.hi.y),
-                     subdiv::mid(cell.lo.z, cell.hi.z)};
+        const Vec3 c = subdiv::centre(cell);
         for (int k = 0; k < 8; ++k) oct[k] = subdiv::octant(cell, c, k);
         std::vector<std::uint8_t> omask;
         std::array<std::size_t, 8> ocounts;
         as.masks(refs, oct, 8, omask, ocounts);
-        std::size_t sum = 0;
-        for (std::size_t n : ocounts) sum += n;
-        if (static_cast<double>(sum) >= o_.growth * static_cast<double>(refs.size())) return make_leaf(node, refs);
+        if (subdiv::hardly_separates(ocounts, refs.size(), o_.growth)) return make_leaf(node, refs);
     }
     const int a = depth % 3;
     const float s = subdiv::mid(cell.lo[a], cell.hi[a]);

@@ -41,6 +41,17 @@ inline constexpr std::size_t kMaxNodes = std::size_t{1} << 23;
 /// The midpoint both builders split at, and the model tree's planes.
 inline float mid(float lo, float hi) { return (lo + hi) * 0.5f; }
 
+/// The centre both builders split at.
+inline Vec3 centre(const Box3& b) { return {mid(b.lo.x, b.hi.x), mid(b.lo.y, b.hi.y), mid(b.lo.z, b.hi.z)}; }
+
+/// The growth guard (kGrowthParam): the octants' reference counts `counts` add up to at least
+/// `growth` times the `n` references of their cell, so subdividing would hardly separate them.
+inline bool hardly_separates(const std::array<std::size_t, 8>& counts, std::size_t n, double growth) {
+    std::size_t sum = 0;
+    for (std::size_t c : counts) sum += c;
+    return static_cast<double>(sum) >= growth * static_cast<double>(n);
+}
+
 /// Half `side` (0 low, 1 high) of `b` cut at `s` on `axis`.
 inline Box3 half(const Box3& b, int axis, float s, int side) {
     Box3 c = b;

@@ -24,26 +24,19 @@ void Octree::make_leaf(std::uint32_t node, const std::vector<std::uint32_t>& ref
     refs_.insert(refs_.end(), refs.begin(), refs.end());
 }
 
-static Vec3 centre(const Box3& b) {
-    return {subdiv::mid(b.lo.x, b.hi.x), subdiv::mid(b.lo.y, b.hi.y), subdiv::mid(b.lo.z, b.hi.z)};
-}
-
 // Recursion depth is at most max_depth <= kMaxDepth.
 void Octree::build(std::uint32_t node, const Box3& cell, int depth, std::vector<std::uint32_t>& refs,
                    const subdiv::Assigner& as) {
     if (refs.size() <= static_cast<std::size_t>(o_.max_prims) || depth >= o_.max_depth ||
         refs_.size() >= subdiv::kMaxRefs || nodes_.size() >= subdiv::kMaxNodes)
         return make_leaf(node, refs);
-    const Vec3 c = centre(cell);
+    const Vec3 c = subdiv::centre(cell);
     Box3 oct[8];
     for (int k = 0; k < 8; ++k) oct[k] = subdiv::octant(cell, c, k);
     std::vector<std::uint8_t> mask;
     std::array<std::size_t, 8> counts;
     as.masks(refs, oct, 8, mask, counts);
-    // The references straddle the centre so much that subdividing would hardly separate them.
-    std::size_t sum = 0;
-    for (std::size_t c : counts) sum += c;
-    if (static_cast<double>(sum) >= o_.growth * static_cast<double>(refs.size())) return make_leaf(node, refs);
+    if (subdiv::hardly_separates(counts, refs.size(), o_.growth)) return make_leaf(node, refs);
     std::vector<std::uint32_t> child[8];
     for (int k = 0; k < 8; ++k) child[k] = subdiv::Assigner::select(refs, mask, k, counts[k]);
     std::vector<std::uint32_t>().swap(refs);  // free the parent's list before descending
