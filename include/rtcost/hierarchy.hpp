@@ -55,10 +55,8 @@ struct ModelNode {
     float beam_u[2] = {-1, 1}, beam_v[2] = {-1, 1};
 };
 
-/// A hierarchy flattened for the model: `nodes[0]` is the root; the children of a node are
-/// contiguous. Binary for space subdivisions; a BVH node may have more than two children
-/// (Goldsmith and Salmon's trees are n-ary), each entered through its own box test.
-struct ModelTree {
+/// The flags of a model tree: what the nodes alone do not say about the traversal.
+struct ModelFlags {
     std::string family;                ///< "bvh", "bsp", "octree", "kd", "grid", "rc5d"
     /// Leaves are found by descending from the root for every cell (Kaplan's and Glassner's
     /// `locate` traversal): each leaf visit pays the operations of all its ancestors again.
@@ -73,9 +71,34 @@ struct ModelTree {
     /// A closest-hit query skips what lies beyond the nearest hit found so far (false: the
     /// traversal visits everything the segment meets, e.g. a BVH with `order=none`).
     bool cull = true;
+};
+
+/// A hierarchy flattened for the model: `nodes[0]` is the root; the children of a node are
+/// contiguous. Binary for space subdivisions; a BVH node may have more than two children
+/// (Goldsmith and Salmon's trees are n-ary), each entered through its own box test.
+struct ModelTree : ModelFlags {
     std::vector<ModelNode> nodes;
     std::vector<std::uint32_t> prims;  ///< leaf primitive references
 };
+
+/// Receives a hierarchy's model tree depth first (Hierarchy::emit_model), so that the model
+/// can read a hierarchy of millions of nodes where it lies instead of copying it: `begin` once,
+/// then `node` for every node in pre-order, a node with `count` children being followed by its
+/// children's whole subtrees, in order.
+class ModelSink {
+public:
+    virtual ~ModelSink() = default;
+    /// The tree's flags, before its root. Returning false ends the emission there (a sink that
+    /// only asks whether there is a model tree).
+    virtual bool begin(const ModelFlags& flags) = 0;
+    /// One node. `m.first` and `m.depth` are not read (the order says them); a leaf's
+    /// primitive ids are `prims`, `m.count` of them.
+    virtual void node(const ModelNode& m, std::span<const std::uint32_t> prims) = 0;
+};
+
+/// Emits a materialised model tree into `sink`, depth first (what Hierarchy::emit_model does
+/// for a hierarchy).
+void emit_model(const ModelTree& tree, ModelSink& sink);
 
 /// One named build parameter, declared by the hierarchy with its default and help text.
 struct ParamSpec {
@@ -134,9 +157,18 @@ public:
 
     const Scene& scene() const { return *scene_; }
 
-    /// The structure as the cost model's tree. Empty for hierarchies the model cannot see into
-    /// (embree).
-    virtual ModelTree model_tree() const { return {}; }
+    /// Emits the structure as the cost model's tree into `sink`, depth first, reading the
+    /// hierarchy's own nodes: no copy of them is made. Emits nothing and returns false for
+    /// hierarchies the model cannot see into (embree).
+    virtual bool emit_model(ModelSink& sink) const {
+        (void)sink;
+        return false;
+    }
+    /// Whether emit_model has a tree to emit.
+    bool modelled() const;
+    /// The model tree, materialised (the sampled estimator, tests and reports index it). Empty
+    /// for hierarchies the model cannot see into.
+    ModelTree model_tree() const;
 
     /// True when the structure grows as rays arrive (Arvo and Kirk's lazy classification):
     /// structure() and model_tree() then describe only what the rays so far have built.

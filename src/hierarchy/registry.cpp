@@ -2,6 +2,7 @@
 #include <charconv>
 #include <chrono>
 #include <fmt/format.h>
+#include <stdexcept>
 
 #include "rtcost/error.hpp"
 #include "rtcost/hierarchy.hpp"
@@ -21,6 +22,87 @@ std::vector<HierarchyInfo>& registry() {
 }
 
 }  // namespace
+
+namespace {
+
+/// Materialises an emitted tree: a node's children get contiguous slots when the node arrives,
+/// and are filled as their subtrees follow.
+class Collector final : public ModelSink {
+public:
+    explicit Collector(ModelTree& t) : t_(t) {}
+    bool begin(const ModelFlags& f) override {
+        static_cast<ModelFlags&>(t_) = f;
+        return true;
+    }
+    void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
+        std::uint32_t at = 0;
+        int depth = 0;
+        if (!t_.nodes.empty()) {
+            if (open_.empty()) throw std::logic_error("model tree: a node after the tree was complete");
+            Slots& s = open_.back();
+            at = s.next++;
+            depth = s.depth;
+            if (s.next == s.end) open_.pop_back();
+        } else {
+            t_.nodes.emplace_back();
+        }
+        ModelNode& n = t_.nodes[at];
+        n = m;
+        n.depth = depth;
+        if (m.leaf) {
+            n.first = static_cast<std::uint32_t>(t_.prims.size());
+            t_.prims.insert(t_.prims.end(), prims.begin(), prims.end());
+        } else {
+            n.first = static_cast<std::uint32_t>(t_.nodes.size());
+            if (m.count > 0) open_.push_back({n.first, n.first + m.count, depth + 1});
+            t_.nodes.resize(t_.nodes.size() + m.count);  // invalidates `n`
+        }
+    }
+
+private:
+    struct Slots {
+        std::uint32_t next, end;
+        int depth;
+    };
+    ModelTree& t_;
+    std::vector<Slots> open_;
+};
+
+/// Declines the nodes: only asks whether there is a tree.
+class Asker final : public ModelSink {
+public:
+    bool begin(const ModelFlags&) override { return false; }
+    void node(const ModelNode&, std::span<const std::uint32_t>) override {}
+};
+
+void emit_subtree(const ModelTree& t, std::uint32_t i, ModelSink& sink) {
+    const ModelNode& m = t.nodes[i];
+    if (m.leaf) {
+        sink.node(m, std::span<const std::uint32_t>(t.prims).subspan(m.first, m.count));
+        return;
+    }
+    sink.node(m, {});
+    for (std::uint32_t k = 0; k < m.count; ++k) emit_subtree(t, m.first + k, sink);
+}
+
+}  // namespace
+
+bool Hierarchy::modelled() const {
+    Asker a;
+    return emit_model(a);
+}
+
+ModelTree Hierarchy::model_tree() const {
+    ModelTree t;
+    Collector c(t);
+    emit_model(c);
+    return t;
+}
+
+void emit_model(const ModelTree& t, ModelSink& sink) {
+    if (!sink.begin(t) || t.nodes.empty()) return;
+    emit_subtree(t, 0, sink);
+}
 
 Registration::Registration(HierarchyInfo info) { registry().push_back(std::move(info)); }
 

@@ -25,16 +25,18 @@ public:
     }
 
     /// One leaf holding every primitive, entered with no box test.
-    ModelTree model_tree() const override {
-        ModelTree t;
-        t.family = "bvh";
-        t.per_ray_box = 0;
+    bool emit_model(ModelSink& sink) const override {
+        ModelFlags f;
+        f.family = "bvh";
+        f.per_ray_box = 0;
+        if (!sink.begin(f)) return true;
+        std::vector<std::uint32_t> ids(scene_->size());
+        for (std::uint32_t id = 0; id < ids.size(); ++id) ids[id] = id;
         ModelNode leaf;
         leaf.region = scene_->bounds();
-        leaf.count = static_cast<std::uint32_t>(scene_->size());
-        t.nodes.push_back(leaf);
-        for (std::uint32_t id = 0; id < scene_->size(); ++id) t.prims.push_back(id);
-        return t;
+        leaf.count = static_cast<std::uint32_t>(ids.size());
+        sink.node(leaf, ids);
+        return true;
     }
 
 protected:

@@ -83,36 +83,33 @@ StructureStats Bsp::compute_structure() const {
 
 // One model node per BSP node (same indices): a visit costs one plane compare and is one step;
 // with `locate` the model charges every leaf visit its whole descent again.
-ModelTree Bsp::model_tree() const {
-    ModelTree t;
-    t.family = "bsp";
-    t.locate = o_.locate;
-    t.per_ray_box = 1;
-    t.prims = refs_;
-    t.nodes.resize(nodes_.size());
-    t.nodes[0].region = root_;
-    for (std::size_t i = 0; i < nodes_.size(); ++i) {
+bool Bsp::emit_model(ModelSink& sink) const {
+    ModelFlags f;
+    f.family = "bsp";
+    f.locate = o_.locate;
+    f.per_ray_box = 1;
+    if (!sink.begin(f) || nodes_.empty()) return true;
+    auto emit = [&](auto&& self, std::uint32_t i, const Box3& region) -> void {
         const Node& n = nodes_[i];
-        ModelNode& m = t.nodes[i];
-        m.first = n.index;
-        m.leaf = n.leaf();
+        ModelNode m;
+        m.region = region;
         m.step = true;
         if (n.leaf()) {
             m.count = n.count;
-            continue;
+            sink.node(m, std::span<const std::uint32_t>(refs_).subspan(n.index, n.count));
+            return;
         }
         const int a = static_cast<int>(n.axis);
+        m.leaf = false;
         m.count = 2;
         m.axis = static_cast<std::int8_t>(a);
         m.split = n.split;
         m.plane = 1;
-        for (int side = 0; side < 2; ++side) {
-            ModelNode& c = t.nodes[n.index + side];
-            c.region = subdiv::half(m.region, a, n.split, side);
-            c.depth = m.depth + 1;
-        }
-    }
-    return t;
+        sink.node(m, {});
+        for (int side = 0; side < 2; ++side) self(self, n.index + side, subdiv::half(region, a, n.split, side));
+    };
+    emit(emit, 0, root_);
+    return true;
 }
 
 namespace {

@@ -62,7 +62,7 @@ public:
     Bsp(const Scene& s, const Options& o);
 
     std::string_view name() const override { return "bsp"; }
-    ModelTree model_tree() const override;
+    bool emit_model(ModelSink& sink) const override;
 
     const Box3& root() const { return root_; }
     const std::vector<Node>& nodes() const { return nodes_; }

@@ -31,26 +31,29 @@ StructureStats Bvh::compute_structure() const {
     return s;
 }
 
-ModelTree Bvh::model_tree() const {
-    ModelTree t;
-    t.family = "bvh";
-    t.cull = ordered_;
-    t.nodes.resize(d_.nodes.size());
-    t.prims = d_.refs;
-    for (std::size_t i = 0; i < d_.nodes.size(); ++i) {
+bool Bvh::emit_model(ModelSink& sink) const {
+    ModelFlags f;
+    f.family = "bvh";
+    f.cull = ordered_;
+    if (!sink.begin(f) || d_.nodes.empty()) return true;
+    auto emit = [&](auto&& self, std::uint32_t i) -> void {
         const Node& n = d_.nodes[i];
-        ModelNode& m = t.nodes[i];
+        ModelNode m;
         m.region = n.box;
         m.has_bv = true;
         m.bv = n.box;
         m.box = n.leaf ? 0.0f : static_cast<float>(n.count);  // a visit tests every child's box
-        m.first = n.index;
         m.count = n.count;
         m.leaf = n.leaf;
-        if (!n.leaf)
-            for (std::uint32_t k = 0; k < n.count; ++k) t.nodes[n.index + k].depth = m.depth + 1;
-    }
-    return t;
+        if (n.leaf) {
+            sink.node(m, std::span<const std::uint32_t>(d_.refs).subspan(n.index, n.count));
+            return;
+        }
+        sink.node(m, {});
+        for (std::uint32_t k = 0; k < n.count; ++k) self(self, n.index + k);
+    };
+    emit(emit, 0);
+    return true;
 }
 
 namespace {

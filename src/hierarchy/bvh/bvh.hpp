@@ -62,7 +62,7 @@ public:
         : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered) {}
 
     std::string_view name() const override { return name_; }
-    ModelTree model_tree() const override;
+    bool emit_model(ModelSink& sink) const override;
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {

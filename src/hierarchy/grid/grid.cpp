@@ -191,44 +191,40 @@ StructureStats Grid::compute_structure() const {
 // except the root, which stands for the grid box and is counted like the traversal's
 // interior(0). Each cell visit is a step and costs one hop; per_entry_hop = -1 because the
 // first cell is reached without one.
-ModelTree Grid::model_tree() const {
-    ModelTree t;
-    t.family = "grid";
-    t.per_ray_box = 1;
-    t.per_entry_hop = -1;
-    t.prims = refs_;
+bool Grid::emit_model(ModelSink& sink) const {
+    ModelFlags f;
+    f.family = "grid";
+    f.per_ray_box = 1;
+    f.per_entry_hop = -1;
+    if (!sink.begin(f)) return true;
     struct Range {
         int lo[3], hi[3];  // cell index ranges, hi exclusive
     };
-    std::vector<Range> work;
-    work.push_back({{0, 0, 0}, {res_[0], res_[1], res_[2]}});
-    t.nodes.emplace_back();
     auto region = [&](const Range& r) {
         return Box3{{planes_[0][r.lo[0]], planes_[1][r.lo[1]], planes_[2][r.lo[2]]},
                     {planes_[0][r.hi[0]], planes_[1][r.hi[1]], planes_[2][r.hi[2]]}};
     };
+    auto cell_refs = [&](std::uint64_t c) {
+        return std::span<const std::uint32_t>(refs_).subspan(offsets_[c], offsets_[c + 1] - offsets_[c]);
+    };
+    const Range all{{0, 0, 0}, {res_[0], res_[1], res_[2]}};
     if (cell_count() == 1) {
         // One cell: the grid node above it, so that the model counts the same steps and depths.
-        ModelNode& root = t.nodes[0];
-        root.region = region(work[0]);
+        ModelNode root;
+        root.region = region(all);
         root.leaf = false;
-        root.first = 1;
         root.count = 1;
         root.step = true;
+        sink.node(root, {});
         ModelNode leaf;
         leaf.region = root.region;
-        leaf.depth = 1;
-        leaf.first = offsets_[0];
         leaf.count = offsets_[1] - offsets_[0];
         leaf.hop = 1;
-        t.nodes.push_back(leaf);
-        return t;
+        sink.node(leaf, cell_refs(0));
+        return true;
     }
-    t.nodes.reserve(2 * cell_count() - 1);
-    work.reserve(2 * cell_count() - 1);
-    for (std::size_t n = 0; n < work.size(); ++n) {
-        const Range r = work[n];
-        ModelNode& m = t.nodes[n];
+    auto emit = [&](auto&& self, const Range& r, bool root) -> void {
+        ModelNode m;
         m.region = region(r);
         int axis = 0;
         for (int a = 1; a < 3; ++a)
@@ -236,33 +232,28 @@ ModelTree Grid::model_tree() const {
         const int len = r.hi[axis] - r.lo[axis];
         if (len == 1) {
             const std::uint64_t c = cell_index(r.lo[0], r.lo[1], r.lo[2]);
-            m.leaf = true;
-            m.first = offsets_[c];
             m.count = offsets_[c + 1] - offsets_[c];
             m.hop = 1;
             m.step = true;
-            continue;
+            sink.node(m, cell_refs(c));
+            return;
         }
         const int mid = r.lo[axis] + len / 2;
         m.leaf = false;
         m.axis = static_cast<std::int8_t>(axis);
         m.split = planes_[axis][mid];
-        m.first = static_cast<std::uint32_t>(t.nodes.size());
         m.count = 2;
         m.hop = 0;
-        m.step = n == 0;
-        const int depth = m.depth;
+        m.step = root;
+        sink.node(m, {});
         Range left = r, right = r;
         left.hi[axis] = mid;
         right.lo[axis] = mid;
-        work.push_back(left);
-        work.push_back(right);
-        ModelNode child;
-        child.depth = depth + 1;
-        t.nodes.push_back(child);  // invalidates `m`
-        t.nodes.push_back(child);
-    }
-    return t;
+        self(self, left, false);
+        self(self, right, false);
+    };
+    emit(emit, all, true);
+    return true;
 }
 
 namespace {

@@ -42,7 +42,7 @@ public:
     Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox);
 
     std::string_view name() const override { return "grid"; }
-    ModelTree model_tree() const override;
+    bool emit_model(ModelSink& sink) const override;
 
     const std::array<int, 3>& res() const { return res_; }
     std::uint64_t cell_count() const { return offsets_.size() - 1; }

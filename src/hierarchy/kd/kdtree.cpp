@@ -128,21 +128,23 @@ StructureStats KdTree::compute_structure() const {
 // Node for node the traversal: an interior visit is one step costing one plane compare, and with
 // node boxes one box test first (the model's gate: the plane is paid only when the box is met).
 // Leaves have no box. The root clip is per_ray_box.
-ModelTree KdTree::model_tree() const {
-    ModelTree t;
-    t.family = "kd";
-    t.per_ray_box = 1;
-    t.prims = d_.refs;
-    t.nodes.resize(d_.nodes.size());
-    t.nodes[0].region = d_.root;
-    for (std::size_t i = 0; i < d_.nodes.size(); ++i) {
+bool KdTree::emit_model(ModelSink& sink) const {
+    ModelFlags f;
+    f.family = "kd";
+    f.per_ray_box = 1;
+    if (!sink.begin(f) || d_.nodes.empty()) return true;
+    auto emit = [&](auto&& self, std::uint32_t i, const Box3& region) -> void {
         const Node& n = d_.nodes[i];
-        ModelNode& m = t.nodes[i];
-        m.first = n.index;
-        m.count = n.count;
-        m.leaf = n.leaf();
+        ModelNode m;
+        m.region = region;
         m.step = true;
-        if (n.leaf()) continue;
+        if (n.leaf()) {
+            m.count = n.count;
+            sink.node(m, std::span<const std::uint32_t>(d_.refs).subspan(n.index, n.count));
+            return;
+        }
+        m.leaf = false;
+        m.count = 2;
         m.axis = static_cast<std::int8_t>(n.axis);
         m.split = n.split;
         m.plane = 1;
@@ -151,14 +153,15 @@ ModelTree KdTree::model_tree() const {
             m.bv = d_.boxes[i];
             m.box = 1;
         }
-        ModelNode& l = t.nodes[n.index];
-        ModelNode& r = t.nodes[n.index + 1];
-        l.region = r.region = m.region;
-        l.region.hi[n.axis] = n.split;
-        r.region.lo[n.axis] = n.split;
-        l.depth = r.depth = m.depth + 1;
-    }
-    return t;
+        sink.node(m, {});
+        Box3 l = region, r = region;
+        l.hi[n.axis] = n.split;
+        r.lo[n.axis] = n.split;
+        self(self, n.index, l);
+        self(self, n.index + 1, r);
+    };
+    emit(emit, 0, d_.root);
+    return true;
 }
 
 namespace {

@@ -128,7 +128,7 @@ public:
           mailbox_(mailbox) {}
 
     std::string_view name() const override { return name_; }
-    ModelTree model_tree() const override;
+    bool emit_model(ModelSink& sink) const override;
     const KdData& data() const { return d_; }
 
     template <class C, Query Q>

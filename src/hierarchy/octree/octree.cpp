@@ -73,80 +73,54 @@ StructureStats Octree::compute_structure() const {
 // Z. The X level carries the visit (one step, three plane compares); the Y and Z levels only
 // carry regions and planes for the probabilities (no step, no operations). A Z-level node's
 // children are the octants (x, y, 0) and (x, y, 1).
-ModelTree Octree::model_tree() const {
-    ModelTree t;
-    t.family = "octree";
-    t.locate = o_.locate;
-    t.per_ray_box = 1;
-    t.prims = refs_;
-    struct Work {
-        std::uint32_t octree, model;
-    };
-    std::vector<Work> work{{0, 0}};
-    // Fourteen model nodes per interior node: reserved, so that millions are not copied as the tree grows.
-    std::size_t interior = 0;
-    for (const Node& n : nodes_) interior += !n.leaf();
-    t.nodes.reserve(1 + 14 * interior);
-    t.nodes.emplace_back();
-    t.nodes[0].region = root_;
-    // Depth first; every node's children are allocated before any of them is expanded, so a
-    // child's index is always greater than its parent's.
-    while (!work.empty()) {
-        const Work w = work.back();
-        work.pop_back();
-        const Node& n = nodes_[w.octree];
+bool Octree::emit_model(ModelSink& sink) const {
+    ModelFlags f;
+    f.family = "octree";
+    f.locate = o_.locate;
+    f.per_ray_box = 1;
+    if (!sink.begin(f) || nodes_.empty()) return true;
+    auto emit = [&](auto&& self, std::uint32_t i, const Box3& region) -> void {
+        const Node& n = nodes_[i];
+        ModelNode m;
+        m.region = region;
+        m.step = true;
         if (n.leaf()) {
-            ModelNode& m = t.nodes[w.model];
-            m.leaf = true;
-            m.step = true;
-            m.first = n.index;
             m.count = n.count;
-            continue;
+            sink.node(m, std::span<const std::uint32_t>(refs_).subspan(n.index, n.count));
+            return;
         }
-        const std::uint32_t ys = static_cast<std::uint32_t>(t.nodes.size());
-        const std::uint32_t zs = ys + 2, os = ys + 6;
-        t.nodes.resize(t.nodes.size() + 14);
-        ModelNode& x = t.nodes[w.model];
-        x.leaf = false;
-        x.axis = 0;
-        x.split = n.center.x;
-        x.first = ys;
-        x.count = 2;
-        x.step = true;
-        x.plane = 3;
-        const Box3 region = x.region;
-        const int depth = x.depth;
+        m.leaf = false;
+        m.count = 2;
+        m.axis = 0;
+        m.split = n.center.x;
+        m.plane = 3;
+        sink.node(m, {});
         for (int xi = 0; xi < 2; ++xi) {
-            ModelNode& y = t.nodes[ys + xi];
+            ModelNode y;
             y.region = subdiv::half(region, 0, n.center.x, xi);
-            y.depth = depth + 1;
             y.leaf = false;
             y.axis = 1;
             y.split = n.center.y;
-            y.first = zs + 2 * xi;
             y.count = 2;
             y.step = false;
+            sink.node(y, {});
             for (int yi = 0; yi < 2; ++yi) {
-                ModelNode& z = t.nodes[zs + 2 * xi + yi];
+                ModelNode z;
                 z.region = subdiv::half(y.region, 1, n.center.y, yi);
-                z.depth = depth + 2;
                 z.leaf = false;
                 z.axis = 2;
                 z.split = n.center.z;
-                z.first = os + 4 * xi + 2 * yi;
                 z.count = 2;
                 z.step = false;
-                for (int zi = 0; zi < 2; ++zi) {
-                    const std::uint32_t mo = z.first + zi;
-                    ModelNode& o = t.nodes[mo];
-                    o.region = subdiv::half(z.region, 2, n.center.z, zi);
-                    o.depth = depth + 3;
-                    work.push_back({n.index + static_cast<std::uint32_t>(xi | yi << 1 | zi << 2), mo});
-                }
+                sink.node(z, {});
+                for (int zi = 0; zi < 2; ++zi)
+                    self(self, n.index + static_cast<std::uint32_t>(xi | yi << 1 | zi << 2),
+                         subdiv::half(z.region, 2, n.center.z, zi));
             }
         }
-    }
-    return t;
+    };
+    emit(emit, 0, root_);
+    return true;
 }
 
 namespace {

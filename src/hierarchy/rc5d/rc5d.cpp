@@ -210,70 +210,54 @@ StructureStats Rc5d::compute_structure() const {
 // box (a u or v split leaves it unchanged), and `axis` is -1 throughout because no split is a
 // plane that a ray crosses: a ray goes to exactly one child. The split dimension of a node at
 // model depth d >= 1 is (d - 1) % 5 (x, y, z, u, v). Pending beams appear as leaves.
-ModelTree Rc5d::model_tree() const {
-    ModelTree t;
-    t.family = "rc5d";
-    t.per_ray_box = 1;
-    t.per_entry_hop = 0;
-    t.one_path = true;
+bool Rc5d::emit_model(ModelSink& sink) const {
+    ModelFlags f;
+    f.family = "rc5d";
+    f.per_ray_box = 1;
+    f.per_entry_hop = 0;
+    f.one_path = true;
+    if (!sink.begin(f)) return true;
     ModelNode root;
     root.region = box_;
     root.leaf = false;
-    root.first = 1;
     root.count = 6;
     root.classify = 3;
-    t.nodes.push_back(root);
-    struct Item {
-        const Node* n;
-        Cell cell;
-        int level;
+    sink.node(root, {});
+    // `m` arrives with the beam's region and directions; the node decides leaf or split.
+    auto emit = [&](auto&& self, const Node& n, const Cell& cell, int level, ModelNode m) -> void {
+        if (n.state.load(std::memory_order_acquire) != kInterior) {
+            m.count = n.count;
+            sink.node(m, std::span<const std::uint32_t>(n.refs.get(), n.count));
+            return;
+        }
+        const int dim = level % 5;
+        m.leaf = false;
+        m.classify = 1;
+        m.count = 2;
+        m.beam_dim = static_cast<std::int8_t>(dim);
+        m.split = n.split;
+        sink.node(m, {});
+        for (int side = 0; side < 2; ++side) {
+            const Cell c = child_cell(cell, dim, n.split, side);
+            ModelNode k;
+            k.region = c.origin_box();
+            k.beam_axis = m.beam_axis;
+            k.beam_negative = m.beam_negative;
+            k.beam_u[0] = c.lo[3];
+            k.beam_u[1] = c.hi[3];
+            k.beam_v[0] = c.lo[4];
+            k.beam_v[1] = c.hi[4];
+            self(self, n.kids[side], c, level + 1, k);
+        }
     };
-    std::vector<Item> work;  // work[i] describes t.nodes[i + 1]
     for (int c = 0; c < 6; ++c) {
-        work.push_back({&cubes_[c], root_, 0});
         ModelNode m;
         m.region = root_.origin_box();
-        m.depth = 1;
         m.beam_axis = static_cast<std::int8_t>(c / 2);
         m.beam_negative = c % 2 == 1;
-        t.nodes.push_back(m);
+        emit(emit, cubes_[c], root_, 0, m);
     }
-    for (std::size_t w = 0; w < work.size(); ++w) {
-        const Item it = work[w];
-        const std::size_t idx = w + 1;
-        if (it.n->state.load(std::memory_order_acquire) == kInterior) {
-            const int dim = it.level % 5;
-            t.nodes[idx].leaf = false;
-            t.nodes[idx].classify = 1;
-            t.nodes[idx].first = static_cast<std::uint32_t>(t.nodes.size());
-            t.nodes[idx].count = 2;
-            t.nodes[idx].beam_dim = static_cast<std::int8_t>(dim);
-            t.nodes[idx].split = it.n->split;
-            const int depth = t.nodes[idx].depth;
-            const ModelNode parent = t.nodes[idx];
-            for (int side = 0; side < 2; ++side) {
-                Cell c = child_cell(it.cell, dim, it.n->split, side);
-                work.push_back({&it.n->kids[side], c, it.level + 1});
-                ModelNode m;
-                m.region = c.origin_box();
-                m.depth = depth + 1;
-                m.beam_axis = parent.beam_axis;
-                m.beam_negative = parent.beam_negative;
-                m.beam_u[0] = c.lo[3];
-                m.beam_u[1] = c.hi[3];
-                m.beam_v[0] = c.lo[4];
-                m.beam_v[1] = c.hi[4];
-                t.nodes.push_back(m);
-            }
-        } else {
-            ModelNode& m = t.nodes[idx];
-            m.leaf = true;
-            m.first = static_cast<std::uint32_t>(t.prims.size());
-            m.count = it.n->count;
-            t.prims.insert(t.prims.end(), it.n->refs.get(), it.n->refs.get() + it.n->count);
-        }
-    }
-    return t;
+    return true;
 }
 
 namespace {

@@ -86,7 +86,7 @@ public:
     Rc5d(const Scene& s, const Options& o);
 
     std::string_view name() const override { return "rc5d"; }
-    ModelTree model_tree() const override;
+    bool emit_model(ModelSink& sink) const override;
     bool lazy() const override { return opt_.lazy; }
 
     const Options& options() const { return opt_; }
