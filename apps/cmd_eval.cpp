@@ -178,8 +178,10 @@ int cmd_eval(EvalArgs& a, const Common& common) {
             for (int k = 0; k < kRayKinds; ++k) trace_rays(*h, train_kinds[k]);
         row.s = h->structure();
         row.lazy = h->lazy();
-        ModelTree tree = h->model_tree();
-        row.modelled = !tree.nodes.empty();
+        row.modelled = h->modelled();
+        // The sampled estimator's probe indexes a materialised tree; the geometric one reads the
+        // hierarchy where it lies.
+        const ModelTree tree = row.modelled && sampled ? h->model_tree() : ModelTree{};
         if (row.modelled) {
             for (const std::string& est : estimators) {
                 for (const std::string& preset : presets) {
@@ -200,7 +202,7 @@ int cmd_eval(EvalArgs& a, const Common& common) {
                         } else {
                             auto it = geometric.find(o.query);
                             if (it == geometric.end())
-                                it = geometric.emplace(o.query, predict_geometric(tree, scene, o, costs)).first;
+                                it = geometric.emplace(o.query, predict_geometric(*h, o, costs)).first;
                             parts.emplace_back(share, it->second);
                         }
                     }

@@ -1,5 +1,5 @@
 // Single-thread traversal and build benchmarks of rtcost's hierarchies against Embree on the same
-// scenes and the same rays. Run: build/bench/rtcost_bench [--benchmark_filter=...]
+// scenes and the same rays, and the geometric estimator against tracing the `spd` rays. Run: build/bench/rtcost_bench [--benchmark_filter=...]
 // Scenes come from ../shared/scenes/spd when present (RTCOST_SHARED overrides), else built-ins.
 #include <benchmark/benchmark.h>
 
@@ -13,6 +13,7 @@
 #include "rtcost/io.hpp"
 #include "rtcost/model.hpp"
 #include "rtcost/rays.hpp"
+#include "rtcost/trace.hpp"
 
 using namespace rtcost;
 
@@ -21,6 +22,7 @@ namespace {
 struct Workload {
     Scene scene;
     std::map<std::string, std::vector<Ray>> rays;  // "random", "camera"
+    std::unique_ptr<RaySet> spd;                   // made on first use: a Whitted ray tree
 };
 
 std::string shared_dir() {
@@ -81,16 +83,33 @@ void build_bench(benchmark::State& state, std::string scene, std::string hierarc
     state.counters["prims"] = static_cast<double>(w.scene.size());
 }
 
-/// The geometric estimator alone (model tree walk and prediction), after the build: the cost of
-/// predicting instead of measuring.
+/// The geometric estimator alone (one pass over the hierarchy's nodes), after the build: the cost
+/// of predicting instead of measuring. Counters: the single-thread time to trace the scene's
+/// `spd` rays through the same hierarchy in the same process (`spd_trace_ms`, traversal alone, as
+/// `rtcost trace --rays spd -j 1 --no-count`) and the estimate's share of it (`share_pct`).
 void model_bench(benchmark::State& state, std::string scene, std::string hierarchy) {
     Workload& w = workload(scene);
     auto h = build_hierarchy(w.scene, hierarchy);
+    if (!w.spd) {
+        RaySpec spec;
+        spec.name = "spd";
+        w.spd = std::make_unique<RaySet>(make_rays(w.scene, spec));
+    }
+    TraceOptions t;
+    t.threads = 1;
+    if (h->lazy()) trace_ray_set(*h, *w.spd, t);  // the first pass builds what the rays need
+    const double trace = trace_ray_set(*h, *w.spd, t).seconds;
     ModelOptions opt;
+    double seconds = 0;
     for (auto _ : state) {
-        Prediction p = predict_geometric(h->model_tree(), w.scene, opt);
+        const auto start = std::chrono::steady_clock::now();
+        Prediction p = predict_geometric(*h, opt);
+        seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         benchmark::DoNotOptimize(p.scalar);
     }
+    const double estimate = state.iterations() > 0 ? seconds / state.iterations() : 0;
+    state.counters["spd_trace_ms"] = trace * 1e3;
+    state.counters["share_pct"] = trace > 0 ? 100 * estimate / trace : 0;
 }
 
 }  // namespace

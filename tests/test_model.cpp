@@ -117,6 +117,71 @@ TEST_P(ModelExactSpd, EveryHierarchyPredictsAllHitsOfLines) {
 INSTANTIATE_TEST_SUITE_P(Spd, ModelExactSpd,
                          ::testing::Values("balls", "gears", "mount", "rings", "teapot", "tetra", "tree"));
 
+TEST(ModelStream, InPlaceEqualsTheMaterialisedTreeForEveryHierarchy) {
+    // The geometric estimator reads a hierarchy where it lies (emit_model); the materialised
+    // tree (model_tree) must describe the same hierarchy node for node, so both predict alike.
+    Scene balls = builtin_scene("balls", 2);
+    Scene tetra = builtin_scene("tetra", 3);
+    int modelled = 0;
+    for (const HierarchyInfo* info : hierarchies()) {
+        for (const Scene* s : {&balls, &tetra}) {
+            std::vector<std::string> set;
+            if (info->name == "rc5d") set = {"build=eager", "max_depth=12"};
+            auto h = build_hierarchy(*s, info->name, set);
+            const ModelTree t = h->model_tree();
+            ASSERT_EQ(h->modelled(), !t.nodes.empty()) << info->name;
+            if (!h->modelled()) {
+                EXPECT_THROW(predict_geometric(*h, ModelOptions{}), InputError) << info->name;
+                continue;
+            }
+            ++modelled;
+            for (Query q : {Query::Closest, Query::Any, Query::All}) {
+                for (Preset pr : {Preset::Exact, Preset::Paper}) {
+                    ModelOptions o;
+                    o.query = q;
+                    o.preset = pr;
+                    const Prediction a = predict_geometric(*h, o), b = predict_geometric(t, *s, o);
+                    EXPECT_GT(a.scalar, 1.0) << info->name;  // at least the root test
+                    EXPECT_NEAR(a.scalar, b.scalar, 1e-9 * b.scalar) << info->name;
+                    EXPECT_NEAR(a.cost.steps, b.cost.steps, 1e-9 * b.cost.steps) << info->name;
+                    EXPECT_NEAR(a.cost.prim_tests(), b.cost.prim_tests(), 1e-9 * b.cost.prim_tests()) << info->name;
+                    ASSERT_EQ(a.visits_by_depth.size(), b.visits_by_depth.size()) << info->name;
+                    for (std::size_t d = 0; d < a.visits_by_depth.size(); ++d)
+                        EXPECT_NEAR(a.visits_by_depth[d], b.visits_by_depth[d], 1e-9) << info->name << " depth " << d;
+                }
+            }
+        }
+    }
+    EXPECT_GE(modelled, 2 * 10);  // every hierarchy but embree, on both scenes
+}
+
+TEST(ModelStream, TheMaterialisedTreeKeepsChildrenContiguousAndDepthsInOrder) {
+    Scene s = builtin_scene("balls", 2);
+    for (const char* name : {"bvh-gs", "kd-median", "octree", "grid"}) {
+        const ModelTree t = build_hierarchy(s, name)->model_tree();
+        ASSERT_FALSE(t.nodes.empty());
+        std::vector<int> parents(t.nodes.size(), 0);
+        std::size_t refs = 0;
+        for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+            const ModelNode& m = t.nodes[i];
+            if (m.leaf) {
+                ASSERT_LE(m.first + m.count, t.prims.size()) << name;
+                refs += m.count;
+                continue;
+            }
+            for (std::uint32_t k = 0; k < m.count; ++k) {
+                ASSERT_LT(m.first + k, t.nodes.size()) << name;
+                EXPECT_GT(m.first + k, i) << name;
+                EXPECT_EQ(t.nodes[m.first + k].depth, m.depth + 1) << name;
+                ++parents[m.first + k];
+            }
+        }
+        EXPECT_EQ(parents[0], 0);
+        for (std::size_t i = 1; i < parents.size(); ++i) EXPECT_EQ(parents[i], 1) << name << " node " << i;
+        EXPECT_EQ(refs, t.prims.size()) << name;  // every reference belongs to exactly one leaf
+    }
+}
+
 TEST(ModelExactness, BruteForceIsEveryPrimitive) {
     Scene s = builtin_scene("tetra", 3);
     auto h = build_hierarchy(s, "brute");

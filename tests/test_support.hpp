@@ -160,11 +160,10 @@ inline Measured measure_all(const Hierarchy& h, std::span<const Ray> rays, const
 inline void expect_model_exact(const Scene& s, const std::string& name, const std::vector<std::string>& set = {},
                                std::size_t n_lines = 200000, double n_se = 3) {
     auto h = build_hierarchy(s, name, set);
-    ModelTree t = h->model_tree();
-    ASSERT_FALSE(t.nodes.empty()) << name;
+    ASSERT_TRUE(h->modelled()) << name;
     ModelOptions opt;
     opt.query = Query::All;
-    Prediction p = predict_geometric(t, s, opt);
+    Prediction p = predict_geometric(*h, opt);  // in place, as eval does
     auto lines = line_rays(s.bounds(), n_lines, 11);
     Measured m = measure_all(*h, lines, UnitCosts{}, Query::All);
     EXPECT_NEAR(p.scalar, m.mean, n_se * m.se + 1e-9) << name << " predicted " << p.scalar << " measured " << m.mean

@@ -124,6 +124,10 @@ struct Prediction {
 /// under the line measure by numerical integration.
 Prediction predict_geometric(const ModelTree& tree, const Scene& scene, const ModelOptions& opt,
                              const UnitCosts& costs = {});
+/// The same, reading the hierarchy's nodes where they lie (Hierarchy::emit_model) in one depth-
+/// first pass that keeps only the open path: no copy of the tree, no array per node. Throws
+/// InputError for a hierarchy the model cannot see into.
+Prediction predict_geometric(const Hierarchy& h, const ModelOptions& opt, const UnitCosts& costs = {});
 
 /// Sampled estimator: a probe traversal of the model tree with each training ray -- children
 /// front to back, real primitive tests, the query's rule for ending (opt.query) -- fills alpha,

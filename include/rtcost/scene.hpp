@@ -41,6 +41,13 @@ struct PrimRef {
     std::uint32_t material;
 };
 
+/// What builders and the cost model read of every primitive, computed once by Scene::finalize.
+struct PrimSummary {
+    Box3 bounds;
+    float area = 0;
+    PrimKind kind = PrimKind::Triangle;
+};
+
 class Scene {
 public:
     std::string name;  ///< file path or builtin spec it came from
@@ -72,8 +79,11 @@ public:
     /// Adds a polygon over `verts`; returns false (adding nothing) when it is degenerate.
     bool add_polygon(std::span<const Vec3> verts, std::uint32_t material, std::uint32_t* id = nullptr);
 
+    /// Bounds and area of primitive `id` (from summaries() once finalized).
     Box3 prim_bounds(std::uint32_t id) const;
     float prim_area(std::uint32_t id) const;
+    /// Every primitive's bounds, area and kind, by id, as of the last finalize() (empty before).
+    const std::vector<PrimSummary>& summaries() const { return summaries_; }
     PrimKind kind(std::uint32_t id) const { return prims[id].kind; }
 
     /// Exact intersection of primitive `id`; see primitive.hpp.
@@ -98,12 +108,13 @@ public:
     /// Bytes of geometry held (primitive arrays and pools).
     std::size_t bytes() const;
 
-    /// Computes bounds and, when the input had no camera, a default one framing the bounds; adds
+    /// Computes the primitives' summaries and bounds and, when the input had no camera, a default one framing the bounds; adds
     /// a default light when there is none and a default material when there is none.
     void finalize();
 
 private:
     Box3 bounds_;
+    std::vector<PrimSummary> summaries_;
 };
 
 }  // namespace rtcost

@@ -7,6 +7,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 #include <numbers>
+#include <stdexcept>
 
 #include "rtcost/error.hpp"
 
@@ -74,24 +75,30 @@ double surface(const Box3& b) {
 
 /// The surface a line must cross to meet the primitive, for Cauchy-Crofton: flat primitives
 /// count both sides; an open cone or cylinder counts its convex hull (side and both rims' discs).
-double crofton_area(const Scene& s, std::uint32_t id) {
-    const PrimRef& p = s.prims[id];
+double crofton_area(const Scene& s, std::uint32_t id, const PrimSummary& p) {
     switch (p.kind) {
         case PrimKind::Triangle:
-        case PrimKind::Polygon: return 2.0 * s.prim_area(id);
-        case PrimKind::Sphere: return s.prim_area(id);
+        case PrimKind::Polygon: return 2.0 * p.area;
+        case PrimKind::Sphere: return p.area;
         case PrimKind::Cone: {
-            const Cone& c = s.cones[p.index];
+            const Cone& c = s.cones[s.prims[id].index];
             double rb = std::fabs(c.base_radius), ra = std::fabs(c.apex_radius);
-            return s.prim_area(id) + std::numbers::pi * (rb * rb + ra * ra);
+            return p.area + std::numbers::pi * (rb * rb + ra * ra);
         }
     }
     return 0;
+}
+double crofton_area(const Scene& s, std::uint32_t id) {
+    return crofton_area(s, id, {s.prim_bounds(id), s.prim_area(id), s.kind(id)});
 }
 
 /// Share of a primitive's bounding box that lies in `region`, measured in the dimensions where
 /// the box has extent (a flat box by area, a line by length).
 double share_inside(const Box3& pb, const Box3& region) {
+    // Wholly inside (every primitive of a BVH leaf): no divisions.
+    if (pb.lo.x >= region.lo.x && pb.lo.y >= region.lo.y && pb.lo.z >= region.lo.z && pb.hi.x <= region.hi.x &&
+        pb.hi.y <= region.hi.y && pb.hi.z <= region.hi.z)
+        return 1;
     double f = 1;
     for (int k = 0; k < 3; ++k) {
         double ext = double(pb.hi[k]) - pb.lo[k];
@@ -140,6 +147,43 @@ struct Walk {
 /// closest-hit one skips what lies beyond, unless the traversal visits everything (ModelTree::cull).
 bool terminates(const ModelTree& t, Query q) { return q == Query::Any || (q == Query::Closest && t.cull); }
 
+/// The families whose `paper` node costs differ.
+enum class Family { Bvh, Grid, Rc5d, Kd, Subdivision };
+
+Family family_of(const std::string& f) {
+    if (f == "bvh") return Family::Bvh;
+    if (f == "grid") return Family::Grid;
+    if (f == "rc5d") return Family::Rc5d;
+    if (f == "kd") return Family::Kd;
+    return Family::Subdivision;  // Kaplan's BSP, Glassner's octree
+}
+
+/// Adds the operations of one visit of `m` to `c`, scaled by `p` (visits) and `pg` (visits that
+/// pass the node's bounding volume). `gamma` and `pb` (P of the first child, 0 without
+/// termination) enter the paper's Kaplan/Glassner term only.
+void charge_visit(CostVector& c, const ModelNode& m, Family f, bool paper, double p, double pg, double gamma,
+                  double pb) {
+    if (!paper) {
+        c.box += p * m.box;
+        c.plane += pg * m.plane;
+        c.hop += pg * m.hop;
+        c.classify += pg * m.classify;
+        return;
+    }
+    if (f == Family::Bvh) {
+        c.box += p;  // the paper charges a node's own box test when it is entered
+    } else if (!m.leaf) {
+        if (f == Family::Grid) c.hop += p;
+        else if (f == Family::Rc5d) c.classify += p;
+        else if (f == Family::Kd) { c.plane += p; c.box += p; }
+        else {
+            // Kaplan/Glassner: 1_cmp + [g (1 - P_B) + (1 - g)] n_f, the far region's entry.
+            c.plane += p;
+            c.box += p * (gamma * (1 - pb) + (1 - gamma));
+        }
+    }
+}
+
 /// q(child | parent visited) for every node from per-node probabilities (the recursion's
 /// coefficients), then pi and the cost vector.
 Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodeProbabilities>& prob,
@@ -155,30 +199,10 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
         if (depth >= static_cast<int>(out.visits_by_depth.size())) out.visits_by_depth.resize(depth + 1, 0.0);
         out.visits_by_depth[depth] += p;
     };
-    // Operations of one node visit, scaled by `p` (visit) and `pg` (visit that passes the BV).
+    const Family fam = family_of(t.family);
     auto charge = [&](const ModelNode& m, double p, double pg, std::size_t i) {
-        if (paper) {
-            const std::string& f = t.family;
-            if (f == "bvh") {
-                c.box += p;  // the paper charges a node's own box test when it is entered
-            } else if (!m.leaf) {
-                if (f == "grid") c.hop += p;
-                else if (f == "rc5d") c.classify += p;
-                else if (f == "kd") { c.plane += p; c.box += p; }
-                else {
-                    // Kaplan/Glassner: 1_cmp + [g (1 - P_B) + (1 - g)] n_f, the far region's entry.
-                    const NodeProbabilities& q = prob[i];
-                    double pb = terminate ? prob[m.first].p_hit : 0.0;
-                    c.plane += p;
-                    c.box += p * (q.gamma * (1 - pb) + (1 - q.gamma));
-                }
-            }
-        } else {
-            c.box += p * m.box;
-            c.plane += pg * m.plane;
-            c.hop += pg * m.hop;
-            c.classify += pg * m.classify;
-        }
+        const double pb = paper && terminate && !m.leaf ? prob[m.first].p_hit : 0.0;
+        charge_visit(c, m, fam, paper, p, pg, prob[i].gamma, pb);
     };
 
     std::vector<double> e;  // reused: no allocation per node
@@ -279,34 +303,6 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
     out.preset = paper ? "paper" : "exact";
     return out;
 }
-
-/// Primitive area inside each node's region, bottom-up (Poisson form of P: 1 - exp(-sum p_i)).
-std::vector<double> area_inside(const ModelTree& t, const Walk& w, const Scene& scene) {
-    // Each primitive's Crofton area and bounds, computed in scene order first: the leaves list
-    // primitives in an order that would make every lookup of their vertices a cache miss.
-    struct PrimGeom {
-        Box3 bounds;
-        float crofton;
-    };
-    std::vector<PrimGeom> geom(scene.size());
-    for (std::uint32_t id = 0; id < geom.size(); ++id)
-        geom[id] = {scene.prim_bounds(id), static_cast<float>(crofton_area(scene, id))};
-    const std::size_t n = t.nodes.size();
-    std::vector<double> a(n, 0.0);
-    for (std::size_t i = n; i-- > 0;) {
-        const ModelNode& m = t.nodes[i];
-        if (m.leaf) {
-            for (std::uint32_t k = 0; k < m.count; ++k) {
-                const PrimGeom& g = geom[t.prims[m.first + k]];
-                a[i] += g.crofton * share_inside(g.bounds, w.visit_box[i]);
-            }
-        } else {
-            for (std::uint32_t k = 0; k < m.count; ++k) a[i] += a[m.first + k];
-        }
-    }
-    return a;
-}
-
 
 // ---- 5D ray classification under the line measure ----------------------------------------
 // A line entering the root box B through face f at a point x with direction w has density
@@ -638,39 +634,262 @@ private:
 
 }  // namespace
 
-Prediction predict_geometric(const ModelTree& t, const Scene& scene, const ModelOptions& opt, const UnitCosts& costs) {
-    if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
-    Walk w(t);
-    if (t.one_path) return predict_one_path_geometric(t, w, scene, opt, costs);
-    const std::size_t n = t.nodes.size();
-    std::vector<NodeProbabilities> prob(n);
-    std::vector<double> inside = area_inside(t, w, scene);
-    for (std::size_t i = 0; i < n; ++i) {
-        const ModelNode& m = t.nodes[i];
-        NodeProbabilities& q = prob[i];
-        double sv = surface(w.visit_box[i]), sg = surface(w.gate_box(i));
-        q.p_bv = sv > 0 ? sg / sv : 0.0;
-        q.p_hit = sv > 0 ? 1 - std::exp(-inside[i] / sv) : 0.0;
-        if (m.leaf) continue;
-        if (m.axis >= 0 && m.count == 2) {
-            q.split = true;
-            double sl = surface(w.visit_box[m.first]), sr = surface(w.visit_box[m.first + 1]);
-            q.alpha = sg > 0 ? 1 - sr / sg : 0.0;
-            q.beta = sg > 0 ? 1 - sl / sg : 0.0;
-            q.both = std::max(0.0f, 1 - q.alpha - q.beta);
-            q.gamma = 0.5;  // isotropic lines: either side first with equal probability
-        } else {
-            for (std::uint32_t k = 0; k < m.count; ++k) {
-                double sc = surface(w.visit_box[m.first + k]);
-                prob[m.first + k].handed = sg > 0 ? sc / sg : 0.0;
-            }
+/// The geometric estimator over an emitted tree (ModelSink), in one depth-first pass that keeps
+/// only the open path: the recursion is linear in the children's costs, so each finished subtree
+/// is summed up as its cost given that its root is visited, and a parent weights its children's
+/// sums by their visit probabilities once all of them are in. No per-node array is made, so a
+/// hierarchy of millions of nodes is read where it lies.
+class GeometricStream final : public ModelSink {
+public:
+    GeometricStream(const Scene& scene, const ModelOptions& opt) : scene_(scene), opt_(opt) {}
+    /// A 5D classification tree (ModelFlags::one_path) is not streamed: it is estimated on the
+    /// materialised tree.
+    bool needs_tree() const { return begun_ && flags_.one_path; }
+
+    bool begin(const ModelFlags& f) override {
+        flags_ = f;
+        begun_ = true;
+        if (f.one_path) return false;  // 5D beams are weighed over the whole tree: see needs_tree
+        fam_ = family_of(f.family);
+        paper_ = opt_.preset == Preset::Paper;
+        terminate_ = opt_.query == Query::Any || (opt_.query == Query::Closest && f.cull);
+        // Each primitive's bounds, area and kind in scene order (the scene's summaries, or
+        // computed here for a scene not finalized since it changed): the leaves list primitives
+        // in an order that would make every lookup of their vertices a cache miss.
+        sums_ = scene_.summaries();
+        if (sums_.size() != scene_.size()) {
+            own_sums_.resize(scene_.size());
+            for (std::uint32_t id = 0; id < own_sums_.size(); ++id)
+                own_sums_[id] = {scene_.prim_bounds(id), scene_.prim_area(id), scene_.kind(id)};
+            sums_ = own_sums_;
+        }
+        return true;
+    }
+
+    void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
+        Box3 visit = m.region;
+        int tdepth = 0;
+        if (top_ > 0) {
+            const Open& parent = stack_[top_ - 1];
+            visit = intersect(parent.gate, m.region);
+            tdepth = parent.tdepth + (parent.m.step ? 1 : 0);
+        } else if (done_) {
+            throw std::logic_error("model tree: a second root");
+        }
+        if (top_ == stack_.size()) stack_.emplace_back();
+        Open& o = stack_[top_++];
+        o.m = m;
+        o.visit = visit;
+        o.gate = m.has_bv ? intersect(visit, m.bv) : visit;
+        o.sv = surface(o.visit);
+        o.sg = surface(o.gate);
+        o.tdepth = tdepth;
+        o.kids_done = 0;
+        if (!m.leaf && o.kids.size() < m.count) o.kids.resize(m.count);
+        if (m.step) max_tdepth_ = std::max(max_tdepth_, tdepth);
+        if (m.leaf || m.count == 0) {
+            finish(prims);
+            // Close every ancestor whose last child this was.
+            while (top_ > 0 && stack_[top_ - 1].kids_done == stack_[top_ - 1].m.count) finish({});
         }
     }
-    Prediction p = evaluate(t, w, prob, scene, opt, costs);
-    p.estimator = "geometric";
-    p.note = "P over several primitives: 1 - exp(-sum p_i), p_i = primitive area (both sides) x share of its "
-             "bounding box in the region / region area";
-    return p;
+
+    Prediction result(const UnitCosts& costs) {
+        if (!begun_ || !done_) throw InputError("model", 0, "this hierarchy has no model tree");
+        if (top_ != 0 || top_ != 0) throw std::logic_error("model tree: the emission ended inside the tree");
+        Prediction out;
+        const Sums& r = root_.sums;
+        CostVector& c = out.cost;
+        c = r.c;
+        out.visits_by_depth.assign(static_cast<std::size_t>(Sums::slot(max_tdepth_)) + 1, 0.0);
+        for (int d = r.dlo; d < r.dhi; ++d) out.visits_by_depth[d] = r.depth[d];
+        // Every ray pays the root's clip test; rays that meet the root pay the per-entry terms.
+        c.box += flags_.per_ray_box;
+        c.hop += flags_.per_entry_hop;
+        out.scalar = costs.scalar(c);
+        out.preset = paper_ ? "paper" : "exact";
+        out.estimator = "geometric";
+        out.note = "P over several primitives: 1 - exp(-sum p_i), p_i = primitive area (both sides) x share of "
+                   "its bounding box in the region / region area";
+        return out;
+    }
+
+private:
+    /// A finished subtree's expected operations given that its root is visited: the cost
+    /// vector, leaf visits (each pays its descent again under `locate`) and steps per traversal
+    /// depth, in [dlo, dhi) (depths past the counters' last, kMaxStatDepth - 1, are counted there).
+    struct Sums {
+        CostVector c;
+        double leaf_visits = 0;
+        int dlo = 0, dhi = 0;
+        std::array<double, kMaxStatDepth> depth;  // only [dlo, dhi) is meaningful: nothing to clear
+        static int slot(int d) { return std::min(d, kMaxStatDepth - 1); }
+        void reset(int lo) {
+            c = CostVector{};
+            leaf_visits = 0;
+            dlo = dhi = slot(lo);
+        }
+        void extend(int hi) {
+            for (; dhi < hi; ++dhi) depth[dhi] = 0;
+        }
+        void add_depth(int d, double v) {
+            d = slot(d);
+            extend(d + 1);
+            depth[d] += v;
+        }
+        /// this += w * o (o's depths start at or below this one's).
+        void add(const Sums& o, double w) {
+            c.box += w * o.c.box;
+            c.plane += w * o.c.plane;
+            c.hop += w * o.c.hop;
+            c.classify += w * o.c.classify;
+            for (int k = 0; k < kPrimKinds; ++k) c.prim[k] += w * o.c.prim[k];
+            c.steps += w * o.c.steps;
+            c.leaves += w * o.c.leaves;
+            c.empty_leaves += w * o.c.empty_leaves;
+            leaf_visits += w * o.leaf_visits;
+            extend(o.dhi);
+            for (int d = o.dlo; d < o.dhi; ++d) depth[d] += w * o.depth[d];
+        }
+    };
+    /// What a parent needs of a finished child.
+    struct Done {
+        double inside = 0;  // primitive (Crofton) area inside the child's visit region
+        double sv = 0;      // surface of the child's visit region
+        float p_hit = 0;
+        Sums sums;
+    };
+    struct Open {
+        ModelNode m;
+        Box3 visit, gate;  // V(N): where a segment must pass for N to be visited; V within N's BV
+        double sv = 0, sg = 0;
+        int tdepth = 0;
+        std::uint32_t kids_done = 0;
+        std::vector<Done> kids;
+    };
+
+    /// Sums up the node on top of the stack (a leaf with `prims`, or a node whose children are
+    /// all done), hands the result to its parent and pops it.
+    void finish(std::span<const std::uint32_t> prims) {
+        Open& o = stack_[top_ - 1];
+        Done& d = top_ >= 2 ? stack_[top_ - 2].kids[stack_[top_ - 2].kids_done++] : root_;
+        const ModelNode& m = o.m;
+        Sums& S = d.sums;
+        S.reset(o.tdepth);
+        const float p_bv = o.sv > 0 ? static_cast<float>(o.sg / o.sv) : 0.0f;
+        const double pg = m.has_bv ? p_bv : 1.0;
+        double inside = 0;
+        if (m.leaf) {
+            for (std::uint32_t id : prims) {
+                const PrimSummary& g = sums_[id];
+                inside += crofton_area(scene_, id, g) * share_inside(g.bounds, o.visit);
+                S.c.prim[static_cast<int>(g.kind)] += pg;
+            }
+            S.c.leaves += 1;
+            if (m.count == 0) S.c.empty_leaves += 1;
+            S.leaf_visits = 1;
+            own(S, o, 1.0, pg, 0.0);
+        } else {
+            const std::uint32_t k = m.count;
+            for (std::uint32_t x = 0; x < k; ++x) inside += o.kids[x].inside;
+            if (m.axis >= 0 && k == 2) {
+                const Done &b = o.kids[0], &cc = o.kids[1];
+                const float alpha = o.sg > 0 ? static_cast<float>(1 - cc.sv / o.sg) : 0.0f;
+                const float beta = o.sg > 0 ? static_cast<float>(1 - b.sv / o.sg) : 0.0f;
+                const double both = std::max(0.0f, 1 - alpha - beta);
+                const double pb = terminate_ ? b.p_hit : 0.0, pc = terminate_ ? cc.p_hit : 0.0;
+                const double g = 0.5;  // isotropic lines: either side first with equal probability
+                S.add(b.sums, pg * (alpha + both * (g + (1 - g) * (1 - pc))));
+                S.add(cc.sums, pg * (beta + both * ((1 - g) + g * (1 - pb))));
+            } else {
+                // Bounding volume children (or any node without a plane): child X is entered when
+                // the segment meets it and no sibling met before it has ended the search. Siblings
+                // are taken in random order: E[prod over those before X of (1 - met_j P_j)]
+                // averaged over the position of X, by elementary symmetric polynomials.
+                handed_.resize(k);
+                for (std::uint32_t x = 0; x < k; ++x)
+                    handed_[x] = o.sg > 0 ? static_cast<float>(o.kids[x].sv / o.sg) : 0.0f;
+                for (std::uint32_t x = 0; x < k; ++x) {
+                    double survive = 1.0;
+                    if (terminate_ && k == 2) {
+                        // The other child is before X half the time.
+                        survive = 0.5 * (2 - handed_[1 - x] * o.kids[1 - x].p_hit);
+                    } else if (terminate_ && k > 2) {
+                        e_.assign(k, 0.0);  // e[j]: elementary symmetric polynomial of degree j
+                        e_[0] = 1;
+                        std::uint32_t used = 0;
+                        for (std::uint32_t y = 0; y < k; ++y) {
+                            if (y == x) continue;
+                            const double sy = 1 - handed_[y] * o.kids[y].p_hit;
+                            ++used;
+                            for (std::uint32_t j = used; j > 0; --j) e_[j] += e_[j - 1] * sy;
+                        }
+                        // X at position j (0-based) has j random siblings before it: mean of
+                        // e_j / C(k-1, j) over j = 0..k-1.
+                        double sum = 0, binom = 1;
+                        for (std::uint32_t j = 0; j < k; ++j) {
+                            sum += e_[j] / binom;
+                            binom = binom * (k - 1 - j) / (j + 1);
+                        }
+                        survive = sum / k;
+                    }
+                    S.add(o.kids[x].sums, pg * handed_[x] * survive);
+                }
+            }
+            own(S, o, 1.0, pg, terminate_ ? o.kids[0].p_hit : 0.0);
+        }
+        d.inside = inside;
+        d.sv = o.sv;
+        // P is read only where a hit ends (part of) the search, or by the paper's Kaplan term.
+        d.p_hit = o.sv > 0 && (terminate_ || paper_) ? 1 - std::exp(static_cast<float>(-inside / o.sv)) : 0.0f;
+        --top_;
+        if (top_ == 0) done_ = true;
+    }
+
+    /// The node's own operations: once per visit, or, under `locate`, once per leaf visit below
+    /// it (every cell is found by a descent from the root).
+    void own(Sums& S, const Open& o, double p, double pg, double pb) {
+        const ModelNode& m = o.m;
+        const double times = flags_.locate && !m.leaf ? S.leaf_visits : p;
+        const double gated = flags_.locate && !m.leaf ? times : pg;
+        charge_visit(S.c, m, fam_, paper_, times, gated, 0.5, pb);
+        if (m.step) {
+            S.c.steps += times;
+            S.add_depth(o.tdepth, times);
+        }
+    }
+
+    const Scene& scene_;
+    ModelOptions opt_;
+    ModelFlags flags_;
+    Family fam_ = Family::Bvh;
+    bool paper_ = false, terminate_ = false, begun_ = false, done_ = false;
+    std::span<const PrimSummary> sums_;
+    std::vector<PrimSummary> own_sums_;
+    std::vector<Open> stack_;
+    std::size_t top_ = 0;
+    Done root_;
+    int max_tdepth_ = 0;
+    std::vector<float> handed_;
+    std::vector<double> e_;
+};
+
+Prediction predict_geometric(const ModelTree& t, const Scene& scene, const ModelOptions& opt, const UnitCosts& costs) {
+    if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
+    if (t.one_path) {
+        Walk w(t);
+        return predict_one_path_geometric(t, w, scene, opt, costs);
+    }
+    GeometricStream g(scene, opt);
+    emit_model(t, g);
+    return g.result(costs);
+}
+
+Prediction predict_geometric(const Hierarchy& h, const ModelOptions& opt, const UnitCosts& costs) {
+    GeometricStream g(h.scene(), opt);
+    h.emit_model(g);
+    if (g.needs_tree()) return predict_geometric(h.model_tree(), h.scene(), opt, costs);
+    return g.result(costs);
 }
 
 Prediction predict_sampled(const ModelTree& t, const Scene& scene, std::span<const Ray> training,

@@ -39,6 +39,7 @@ bool Scene::add_polygon(std::span<const Vec3> verts, std::uint32_t material, std
 }
 
 Box3 Scene::prim_bounds(std::uint32_t id) const {
+    if (id < summaries_.size()) return summaries_[id].bounds;
     const PrimRef& p = prims[id];
     switch (p.kind) {
         case PrimKind::Triangle: return rtcost::bounds(triangles[p.index]);
@@ -50,6 +51,7 @@ Box3 Scene::prim_bounds(std::uint32_t id) const {
 }
 
 float Scene::prim_area(std::uint32_t id) const {
+    if (id < summaries_.size()) return summaries_[id].area;
     const PrimRef& p = prims[id];
     switch (p.kind) {
         case PrimKind::Triangle: return rtcost::area(triangles[p.index]);
@@ -80,12 +82,20 @@ std::size_t Scene::bytes() const {
     return prims.capacity() * sizeof(PrimRef) + triangles.capacity() * sizeof(Triangle) +
            polygons.capacity() * sizeof(Polygon) + polygon_vertices.capacity() * sizeof(Vec3) +
            spheres.capacity() * sizeof(Sphere) + cones.capacity() * sizeof(Cone) +
+           summaries_.capacity() * sizeof(PrimSummary) +
            materials.capacity() * sizeof(Material) + lights.capacity() * sizeof(Light);
 }
 
 void Scene::finalize() {
+    // Computed afresh: the geometry may have changed since the last call.
+    summaries_.clear();
+    std::vector<PrimSummary> sums(prims.size());
     bounds_ = Box3{};
-    for (std::uint32_t id = 0; id < prims.size(); ++id) bounds_.extend(prim_bounds(id));
+    for (std::uint32_t id = 0; id < prims.size(); ++id) {
+        sums[id] = {prim_bounds(id), prim_area(id), prims[id].kind};
+        bounds_.extend(sums[id].bounds);
+    }
+    summaries_ = std::move(sums);
     if (materials.empty()) materials.push_back(Material{});
     if (empty()) return;
     Vec3 c = bounds_.center();
