@@ -15,7 +15,7 @@ def main():
     data = json.load(open(sys.argv[1]))
     trace = defaultdict(dict)   # (scene, dist) -> hierarchy -> (Mrays/s, bytes)
     build = defaultdict(dict)   # scene -> hierarchy -> ms
-    model = defaultdict(dict)   # scene -> hierarchy -> ms
+    model = defaultdict(dict)   # scene -> hierarchy -> (ms, spd trace ms, share %)
     for b in data["benchmarks"]:
         parts = b["name"].split("/")
         if parts[0] == "trace":
@@ -24,7 +24,7 @@ def main():
         elif parts[0] == "build":
             build[parts[1]][parts[2]] = b["real_time"]
         elif parts[0] == "model":
-            model[parts[1]][parts[2]] = b["real_time"]
+            model[parts[1]][parts[2]] = (b["real_time"], b.get("spd_trace_ms", 0), b.get("share_pct", 0))
     print("### Traversal, one thread (closest hit)\n")
     print("| scene | rays | hierarchy | Mrays/s | x Embree | memory |")
     print("|---|---|---|---|---|---|")
@@ -42,12 +42,12 @@ def main():
         for h, ms in hs.items():
             print(f"| {scene} | {h} | {ms:.1f} | {ms / ref:.2f} |" if ref else f"| {scene} | {h} | {ms:.1f} | - |")
     if model:
-        print("\n### Geometric estimator (model tree and prediction, after the build)\n")
-        print("| scene | hierarchy | ms |")
-        print("|---|---|---|")
+        print("\n### Geometric estimator against tracing the `spd` rays (one thread, same run)\n")
+        print("| scene | hierarchy | estimate, ms | spd trace, ms | share | under 5% |")
+        print("|---|---|---|---|---|---|")
         for scene, hs in model.items():
-            for h, ms in hs.items():
-                print(f"| {scene} | {h} | {ms:.2f} |")
+            for h, (ms, trace, share) in hs.items():
+                print(f"| {scene} | {h} | {ms:.2f} | {trace:.1f} | {share:.1f}% | {'yes' if share < 5 else 'no'} |")
 
 
 if __name__ == "__main__":

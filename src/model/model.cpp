@@ -682,7 +682,7 @@ public:
         o.visit = visit;
         o.gate = m.has_bv ? intersect(visit, m.bv) : visit;
         o.sv = surface(o.visit);
-        o.sg = surface(o.gate);
+        o.sg = m.has_bv ? surface(o.gate) : o.sv;
         o.tdepth = tdepth;
         o.kids_done = 0;
         if (!m.leaf && o.kids.size() < m.count) o.kids.resize(m.count);
@@ -776,8 +776,7 @@ private:
         const ModelNode& m = o.m;
         Sums& S = d.sums;
         S.reset(o.tdepth);
-        const float p_bv = o.sv > 0 ? static_cast<float>(o.sg / o.sv) : 0.0f;
-        const double pg = m.has_bv ? p_bv : 1.0;
+        const double pg = !m.has_bv ? 1.0 : o.sv > 0 ? static_cast<float>(o.sg / o.sv) : 0.0f;
         double inside = 0;
         if (m.leaf) {
             for (std::uint32_t id : prims) {
