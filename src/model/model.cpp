@@ -737,6 +737,24 @@ private:
             extend(d + 1);
             depth[d] += v;
         }
+        /// this = wa * a + wb * b, from depth `lo` on (a's and b's depths start at or below it):
+        /// a binary node's sums without clearing first.
+        void weigh(const Sums& a, double wa, const Sums& b, double wb, int lo) {
+            c.box = wa * a.c.box + wb * b.c.box;
+            c.plane = wa * a.c.plane + wb * b.c.plane;
+            c.hop = wa * a.c.hop + wb * b.c.hop;
+            c.classify = wa * a.c.classify + wb * b.c.classify;
+            for (int k = 0; k < kPrimKinds; ++k) c.prim[k] = wa * a.c.prim[k] + wb * b.c.prim[k];
+            c.steps = wa * a.c.steps + wb * b.c.steps;
+            c.leaves = wa * a.c.leaves + wb * b.c.leaves;
+            c.empty_leaves = wa * a.c.empty_leaves + wb * b.c.empty_leaves;
+            leaf_visits = wa * a.leaf_visits + wb * b.leaf_visits;
+            dlo = slot(lo);
+            dhi = std::max({dlo, a.dhi, b.dhi});
+            for (int d = dlo; d < dhi; ++d)
+                depth[d] = (d >= a.dlo && d < a.dhi ? wa * a.depth[d] : 0.0) +
+                           (d >= b.dlo && d < b.dhi ? wb * b.depth[d] : 0.0);
+        }
         /// this += w * o (o's depths start at or below this one's).
         void add(const Sums& o, double w) {
             c.box += w * o.c.box;
@@ -775,10 +793,10 @@ private:
         Done& d = top_ >= 2 ? stack_[top_ - 2].kids[stack_[top_ - 2].kids_done++] : root_;
         const ModelNode& m = o.m;
         Sums& S = d.sums;
-        S.reset(o.tdepth);
         const double pg = !m.has_bv ? 1.0 : o.sv > 0 ? static_cast<float>(o.sg / o.sv) : 0.0f;
         double inside = 0;
         if (m.leaf) {
+            S.reset(o.tdepth);
             for (std::uint32_t id : prims) {
                 const PrimSummary& g = sums_[id];
                 inside += crofton_area(scene_, id, g) * share_inside(g.bounds, o.visit);
@@ -798,14 +816,15 @@ private:
                 const double both = std::max(0.0f, 1 - alpha - beta);
                 const double pb = terminate_ ? b.p_hit : 0.0, pc = terminate_ ? cc.p_hit : 0.0;
                 const double g = 0.5;  // isotropic lines: either side first with equal probability
-                S.add(b.sums, pg * (alpha + both * (g + (1 - g) * (1 - pc))));
-                S.add(cc.sums, pg * (beta + both * ((1 - g) + g * (1 - pb))));
+                S.weigh(b.sums, pg * (alpha + both * (g + (1 - g) * (1 - pc))), cc.sums,
+                        pg * (beta + both * ((1 - g) + g * (1 - pb))), o.tdepth);
             } else {
                 // Bounding volume children (or any node without a plane): child X is entered when
                 // the segment meets it and no sibling met before it has ended the search. Siblings
                 // are taken in random order: E[prod over those before X of (1 - met_j P_j)]
                 // averaged over the position of X, by elementary symmetric polynomials.
                 handed_.resize(k);
+                weight_.resize(k);
                 for (std::uint32_t x = 0; x < k; ++x)
                     handed_[x] = o.sg > 0 ? static_cast<float>(o.kids[x].sv / o.sg) : 0.0f;
                 for (std::uint32_t x = 0; x < k; ++x) {
@@ -832,7 +851,13 @@ private:
                         }
                         survive = sum / k;
                     }
-                    S.add(o.kids[x].sums, pg * handed_[x] * survive);
+                    weight_[x] = pg * handed_[x] * survive;
+                }
+                if (k == 2) {
+                    S.weigh(o.kids[0].sums, weight_[0], o.kids[1].sums, weight_[1], o.tdepth);
+                } else {
+                    S.reset(o.tdepth);
+                    for (std::uint32_t x = 0; x < k; ++x) S.add(o.kids[x].sums, weight_[x]);
                 }
             }
             own(S, o, 1.0, pg, terminate_ ? o.kids[0].p_hit : 0.0);
@@ -840,7 +865,8 @@ private:
         d.inside = inside;
         d.sv = o.sv;
         // P is read only where a hit ends (part of) the search, or by the paper's Kaplan term.
-        d.p_hit = o.sv > 0 && (terminate_ || paper_) ? 1 - std::exp(static_cast<float>(-inside / o.sv)) : 0.0f;
+        d.p_hit = inside > 0 && o.sv > 0 && (terminate_ || paper_) ? 1 - std::exp(static_cast<float>(-inside / o.sv))
+                                                                   : 0.0f;
         --top_;
         if (top_ == 0) done_ = true;
     }
@@ -870,6 +896,7 @@ private:
     Done root_;
     int max_tdepth_ = 0;
     std::vector<float> handed_;
+    std::vector<double> weight_;
     std::vector<double> e_;
 };
 
