@@ -88,9 +88,6 @@ double crofton_area(const Scene& s, std::uint32_t id, const PrimSummary& p) {
     }
     return 0;
 }
-double crofton_area(const Scene& s, std::uint32_t id) {
-    return crofton_area(s, id, {s.prim_bounds(id), s.prim_area(id), s.kind(id)});
-}
 
 /// Share of a primitive's bounding box that lies in `region`, measured in the dimensions where
 /// the box has extent (a flat box by area, a line by length).
@@ -369,49 +366,6 @@ double beam_weight(const ModelNode& m, const Box3& b) {
 /// Forward start of a primitive along a beam's dominant axis (its bounding box's near face).
 double forward_start(const Box3& pb, int k, bool negative) { return negative ? -double(pb.hi[k]) : double(pb.lo[k]); }
 
-Prediction predict_one_path_geometric(const ModelTree& t, const Walk& w, const Scene& scene, const ModelOptions& opt,
-                                      const UnitCosts& costs) {
-    const std::size_t n = t.nodes.size();
-    std::vector<NodeProbabilities> prob(n);
-    std::vector<double> weight(n, 0.0);
-    const Box3& root = t.nodes[0].region;
-    for (std::size_t i = n; i-- > 1;) {
-        const ModelNode& m = t.nodes[i];
-        if (m.leaf) weight[i] = beam_weight(m, root);
-        else
-            for (std::uint32_t k = 0; k < m.count; ++k) weight[i] += weight[m.first + k];
-    }
-    for (std::uint32_t k = 0; k < t.nodes[0].count; ++k) weight[0] += weight[t.nodes[0].first + k];
-    for (std::size_t i = 0; i < n; ++i) {
-        const ModelNode& m = t.nodes[i];
-        if (m.leaf) {
-            // Ordered search: candidate j is tested unless an earlier one ended the search; each
-            // earlier candidate is hit with p = its Crofton area over the surface of the box
-            // around the leaf's candidates (an approximation: independence, no occlusion order).
-            Box3 around;
-            for (std::uint32_t k = 0; k < m.count; ++k) around.extend(scene.prim_bounds(t.prims[m.first + k]));
-            double sa = surface(around);
-            double alive = 1;
-            prob[i].ordered = true;
-            for (std::uint32_t k = 0; k < m.count; ++k) {
-                std::uint32_t id = t.prims[m.first + k];
-                prob[i].tests[static_cast<int>(scene.kind(id))] += alive;
-                double p = sa > 0 ? std::min(1.0, crofton_area(scene, id) / sa) : 0.0;
-                alive *= 1 - p;
-            }
-            continue;
-        }
-        for (std::uint32_t k = 0; k < m.count; ++k)
-            prob[m.first + k].handed = weight[i] > 0 ? weight[m.first + k] / weight[i] : 0.0;
-    }
-    Prediction p = evaluate(t, w, prob, scene, opt, costs);
-    p.estimator = "geometric";
-    p.note = "5D beams: probability of each beam under the line measure by numerical integration; ordered "
-             "candidates: P(search reaches j) = prod over earlier candidates of (1 - Crofton area / area of "
-             "the box around the leaf's candidates)";
-    return p;
-}
-
 /// The share of rays that meet the root: the recursion predicts per ray that does; every ray
 /// still pays the root test.
 void scale_to_share(Prediction& p, const ModelTree& t, double share, const UnitCosts& costs) {
@@ -642,14 +596,10 @@ private:
 class GeometricStream final : public ModelSink {
 public:
     GeometricStream(const Scene& scene, const ModelOptions& opt) : scene_(scene), opt_(opt) {}
-    /// A 5D classification tree (ModelFlags::one_path) is not streamed: it is estimated on the
-    /// materialised tree.
-    bool needs_tree() const { return begun_ && flags_.one_path; }
 
     bool begin(const ModelFlags& f) override {
         flags_ = f;
         begun_ = true;
-        if (f.one_path) return false;  // 5D beams are weighed over the whole tree: see needs_tree
         fam_ = family_of(f.family);
         paper_ = opt_.preset == Preset::Paper;
         terminate_ = opt_.query == Query::Any || (opt_.query == Query::Closest && f.cull);
@@ -669,6 +619,7 @@ public:
     void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
         Box3 visit = m.region;
         int tdepth = 0;
+        if (top_ == 0 && !done_) root_region_ = m.region;
         if (top_ > 0) {
             const Open& parent = stack_[top_ - 1];
             visit = intersect(parent.gate, m.region);
@@ -696,7 +647,7 @@ public:
 
     Prediction result(const UnitCosts& costs) {
         if (!begun_ || !done_) throw InputError("model", 0, "this hierarchy has no model tree");
-        if (top_ != 0 || top_ != 0) throw std::logic_error("model tree: the emission ended inside the tree");
+        if (top_ != 0) throw std::logic_error("model tree: the emission ended inside the tree");
         Prediction out;
         const Sums& r = root_.sums;
         CostVector& c = out.cost;
@@ -709,8 +660,12 @@ public:
         out.scalar = costs.scalar(c);
         out.preset = paper_ ? "paper" : "exact";
         out.estimator = "geometric";
-        out.note = "P over several primitives: 1 - exp(-sum p_i), p_i = primitive area (both sides) x share of "
-                   "its bounding box in the region / region area";
+        out.note = flags_.one_path
+                       ? "5D beams: probability of each beam under the line measure by numerical integration; ordered "
+                         "candidates: P(search reaches j) = prod over earlier candidates of (1 - Crofton area / area of "
+                         "the box around the leaf's candidates)"
+                       : "P over several primitives: 1 - exp(-sum p_i), p_i = primitive area (both sides) x share of "
+                         "its bounding box in the region / region area";
         return out;
     }
 
@@ -793,6 +748,10 @@ private:
         Done& d = top_ >= 2 ? stack_[top_ - 2].kids[stack_[top_ - 2].kids_done++] : root_;
         const ModelNode& m = o.m;
         Sums& S = d.sums;
+        if (flags_.one_path) {
+            finish_one_path(o, d, prims);
+            return;
+        }
         const double pg = !m.has_bv ? 1.0 : o.sv > 0 ? static_cast<float>(o.sg / o.sv) : 0.0f;
         double inside = 0;
         if (m.leaf) {
@@ -871,6 +830,45 @@ private:
         if (top_ == 0) done_ = true;
     }
 
+    /// A 5D classification node: its children are disjoint sets of rays, each taken with its
+    /// share of the node's line-measure weight (`Done::inside` holds the weight here); a leaf's
+    /// candidates are searched in order and the search may stop at each.
+    void finish_one_path(const Open& o, Done& d, std::span<const std::uint32_t> prims) {
+        const ModelNode& m = o.m;
+        Sums& S = d.sums;
+        S.reset(o.tdepth);
+        double weight = 0;
+        if (m.leaf) {
+            weight = beam_weight(m, root_region_);
+            // Ordered search: candidate j is tested unless an earlier one ended the search; each
+            // earlier candidate is hit with p = its Crofton area over the surface of the box
+            // around the leaf's candidates (an approximation: independence, no occlusion order).
+            Box3 around;
+            for (std::uint32_t id : prims) around.extend(sums_[id].bounds);
+            const double sa = surface(around);
+            std::array<double, kPrimKinds> tests{};
+            double alive = 1;
+            for (std::uint32_t id : prims) {
+                const PrimSummary& g = sums_[id];
+                tests[static_cast<int>(g.kind)] += alive;
+                if (terminate_) alive *= 1 - (sa > 0 ? std::min(1.0, crofton_area(scene_, id, g) / sa) : 0.0);
+                else S.c.prim[static_cast<int>(g.kind)] += 1;
+            }
+            if (terminate_)
+                for (int k = 0; k < kPrimKinds; ++k) S.c.prim[k] += static_cast<float>(tests[k]);
+            S.c.leaves += 1;
+            if (m.count == 0) S.c.empty_leaves += 1;
+        } else {
+            for (std::uint32_t x = 0; x < m.count; ++x) weight += o.kids[x].inside;
+            for (std::uint32_t x = 0; x < m.count; ++x)
+                S.add(o.kids[x].sums, weight > 0 ? static_cast<float>(o.kids[x].inside / weight) : 0.0f);
+        }
+        own(S, o, 1.0, 1.0, 0.0);
+        d.inside = weight;
+        --top_;
+        if (top_ == 0) done_ = true;
+    }
+
     /// The node's own operations: once per visit, or, under `locate`, once per leaf visit below
     /// it (every cell is found by a descent from the root).
     void own(Sums& S, const Open& o, double p, double pg, double pb) {
@@ -897,15 +895,12 @@ private:
     int max_tdepth_ = 0;
     std::vector<float> handed_;
     std::vector<double> weight_;
+    Box3 root_region_;  // 5D: the root box, whose faces the lines enter through
     std::vector<double> e_;
 };
 
 Prediction predict_geometric(const ModelTree& t, const Scene& scene, const ModelOptions& opt, const UnitCosts& costs) {
     if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
-    if (t.one_path) {
-        Walk w(t);
-        return predict_one_path_geometric(t, w, scene, opt, costs);
-    }
     GeometricStream g(scene, opt);
     emit_model(t, g);
     return g.result(costs);
@@ -914,7 +909,6 @@ Prediction predict_geometric(const ModelTree& t, const Scene& scene, const Model
 Prediction predict_geometric(const Hierarchy& h, const ModelOptions& opt, const UnitCosts& costs) {
     GeometricStream g(h.scene(), opt);
     h.emit_model(g);
-    if (g.needs_tree()) return predict_geometric(h.model_tree(), h.scene(), opt, costs);
     return g.result(costs);
 }
 
