@@ -94,9 +94,8 @@ struct NodeProbabilities {
     /// with this node first (sampled estimator; negative: use p_hit).
     float p_first = -1;
     float p_bv = 1;    ///< the segment meets the node's bounding volume (when it has one)
-    /// A child of a node with more than two children: the share of the parent's visits that
-    /// entered it, counted by the sampled estimator's probe (negative: from `handed`, P and a
-    /// random order of the siblings).
+    /// A child of a node without a plane split: the share of the parent's visits that entered
+    /// it, counted by the sampled estimator's probe.
     float entered = -1;
     /// With `ordered`: expected primitive tests per visit of a leaf, by kind, when the search
     /// may stop inside it (5D candidates searched in order; sampled: an any-hit query's leaves).

@@ -181,8 +181,8 @@ void charge_visit(CostVector& c, const ModelNode& m, Family f, bool paper, doubl
     }
 }
 
-/// q(child | parent visited) for every node from per-node probabilities (the recursion's
-/// coefficients), then pi and the cost vector.
+/// The sampled estimator's recursion: q(child | parent visited) for every node from per-node
+/// probabilities counted by the probe (the recursion's coefficients), then pi and the cost vector.
 Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodeProbabilities>& prob,
                     const Scene& scene, const ModelOptions& opt, const UnitCosts& costs) {
     const std::size_t n = t.nodes.size();
@@ -202,7 +202,6 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
         charge_visit(c, m, fam, paper, p, pg, prob[i].gamma, pb);
     };
 
-    std::vector<double> e;  // reused: no allocation per node
     // Primitive kinds in scene order: looking each reference up in scene.prims would miss the cache.
     std::vector<std::uint8_t> kind(scene.size());
     for (std::uint32_t id = 0; id < kind.size(); ++id) kind[id] = static_cast<std::uint8_t>(scene.kind(id));
@@ -253,44 +252,10 @@ Prediction evaluate(const ModelTree& t, const Walk& w, const std::vector<NodePro
             pi[b] = pg * (q.alpha + both * (g + (1 - g) * (1 - pc)));
             pi[cc] = pg * (q.beta + both * ((1 - g) + g * (1 - pb)));
         } else {
-            // Bounding volume children (or any node without a plane): child X is entered when the
-            // segment meets it and no sibling met before it has ended the search. Siblings are
-            // taken in random order: E[prod over those before X of (1 - met_j P_j)] averaged over
-            // the position of X, by elementary symmetric polynomials.
-            const std::uint32_t k = m.count;
-            for (std::uint32_t x = 0; x < k; ++x) {
-                const std::uint32_t cx = m.first + x;
-                if (prob[cx].entered >= 0) {  // sampled: counted, no order to assume
-                    pi[cx] = pg * prob[cx].entered;
-                    continue;
-                }
-                double met_x = prob[cx].handed;  // P(X | parent) stored in `handed`
-                double survive = 1.0;
-                if (terminate && k == 2) {
-                    // The other child is before X half the time.
-                    const std::uint32_t y = m.first + (1 - x);
-                    survive = 0.5 * (2 - prob[y].handed * prob[y].p_hit);
-                } else if (terminate && k > 2) {
-                    e.assign(k, 0.0);  // e[j]: elementary symmetric polynomial of degree j
-                    e[0] = 1;
-                    std::uint32_t used = 0;
-                    for (std::uint32_t y = 0; y < k; ++y) {
-                        if (y == x) continue;
-                        double s = 1 - prob[m.first + y].handed * prob[m.first + y].p_hit;
-                        ++used;
-                        for (std::uint32_t j = used; j > 0; --j) e[j] += e[j - 1] * s;
-                    }
-                    // X at position j (0-based) has j random siblings before it: mean of
-                    // e_j / C(k-1, j) over j = 0..k-1.
-                    double sum = 0, binom = 1;
-                    for (std::uint32_t j = 0; j < k; ++j) {
-                        sum += e[j] / binom;
-                        binom = binom * (k - 1 - j) / (j + 1);
-                    }
-                    survive = sum / k;
-                }
-                pi[cx] = pg * met_x * survive;
-            }
+            // Children of any other node: the share of the parent's visits that entered each, as
+            // the sampled estimator's probe counted it (no order of the siblings to assume).
+            for (std::uint32_t x = 0; x < m.count; ++x)
+                pi[m.first + x] = pg * std::max(0.0f, prob[m.first + x].entered);
         }
     }
     // Every ray pays the root's clip test; rays that meet the root pay the per-entry terms.
