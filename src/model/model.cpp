@@ -109,40 +109,38 @@ double share_inside(const Box3& pb, const Box3& region) {
     return f;
 }
 
+/// Each node's parent and traversal depth (the number of its ancestors that are steps), for the
+/// sampled estimator's recursion over a materialised tree.
 struct Walk {
-    const ModelTree& t;
     std::vector<int> parent;
-    std::vector<int> tdepth;      // traversal depth: number of step ancestors
-    std::vector<Box3> visit_box;  // V(N): where a segment must pass for N to be visited
+    std::vector<int> tdepth;
 
-    explicit Walk(const ModelTree& tree) : t(tree) {
-        const std::size_t n = t.nodes.size();
-        parent.assign(n, -1);
-        tdepth.assign(n, 0);
-        visit_box.resize(n);
-        visit_box[0] = t.nodes[0].region;
-        for (std::size_t i = 0; i < n; ++i) {
+    explicit Walk(const ModelTree& t) : parent(t.nodes.size(), -1), tdepth(t.nodes.size(), 0) {
+        for (std::size_t i = 0; i < t.nodes.size(); ++i) {
             const ModelNode& m = t.nodes[i];
             if (m.leaf) continue;
-            const Box3 gate = gate_box(i);
             for (std::uint32_t k = 0; k < m.count; ++k) {
-                std::uint32_t c = m.first + k;
-                parent[c] = static_cast<int>(i);
-                tdepth[c] = tdepth[i] + (m.step ? 1 : 0);
-                visit_box[c] = intersect(gate, t.nodes[c].region);
+                parent[m.first + k] = static_cast<int>(i);
+                tdepth[m.first + k] = tdepth[i] + (m.step ? 1 : 0);
             }
         }
     }
-    /// V(N) within N's bounding volume, when it has one.
-    Box3 gate_box(std::size_t i) const {
-        const ModelNode& m = t.nodes[i];
-        return m.has_bv ? intersect(visit_box[i], m.bv) : visit_box[i];
-    }
 };
 
+/// The cost vector's scalar fields (its `prim` array aside), for sums field by field.
+constexpr double CostVector::*kCostFields[] = {&CostVector::box,   &CostVector::plane,  &CostVector::hop,
+                                              &CostVector::classify, &CostVector::steps, &CostVector::leaves,
+                                              &CostVector::empty_leaves};
+
+/// y += w x.
+void add_scaled(CostVector& y, const CostVector& x, double w) {
+    for (auto f : kCostFields) y.*f += w * x.*f;
+    for (int k = 0; k < kPrimKinds; ++k) y.prim[k] += w * x.prim[k];
+}
+
 /// Whether a hit found ends (part of) the search: an any-hit query stops at its first hit; a
-/// closest-hit one skips what lies beyond, unless the traversal visits everything (ModelTree::cull).
-bool terminates(const ModelTree& t, Query q) { return q == Query::Any || (q == Query::Closest && t.cull); }
+/// closest-hit one skips what lies beyond, unless the traversal visits everything (ModelFlags::cull).
+bool terminates(const ModelFlags& f, Query q) { return q == Query::Any || (q == Query::Closest && f.cull); }
 
 /// The families whose `paper` node costs differ.
 enum class Family { Bvh, Grid, Rc5d, Kd, Subdivision };
@@ -336,11 +334,9 @@ double forward_start(const Box3& pb, int k, bool negative) { return negative ? -
 void scale_to_share(Prediction& p, const ModelTree& t, double share, const UnitCosts& costs) {
     CostVector& c = p.cost;
     c.box -= t.per_ray_box;
-    auto scale = [&](double& v) { v *= share; };
-    scale(c.box); scale(c.plane); scale(c.hop); scale(c.classify);
-    for (auto& v : c.prim) scale(v);
-    scale(c.steps); scale(c.leaves); scale(c.empty_leaves);
-    for (auto& v : p.visits_by_depth) scale(v);
+    for (auto f : kCostFields) c.*f *= share;
+    for (auto& v : c.prim) v *= share;
+    for (auto& v : p.visits_by_depth) v *= share;
     c.box += t.per_ray_box;
     p.scalar = costs.scalar(c);
 }
@@ -567,7 +563,7 @@ public:
         begun_ = true;
         fam_ = family_of(f.family);
         paper_ = opt_.preset == Preset::Paper;
-        terminate_ = opt_.query == Query::Any || (opt_.query == Query::Closest && f.cull);
+        terminate_ = terminates(f, opt_.query);
         // Each primitive's bounds, area and kind in scene order (the scene's summaries, or
         // computed here for a scene not finalized since it changed): the leaves list primitives
         // in an order that would make every lookup of their vertices a cache miss.
@@ -660,14 +656,8 @@ private:
         /// this = wa * a + wb * b, from depth `lo` on (a's and b's depths start at or below it):
         /// a binary node's sums without clearing first.
         void weigh(const Sums& a, double wa, const Sums& b, double wb, int lo) {
-            c.box = wa * a.c.box + wb * b.c.box;
-            c.plane = wa * a.c.plane + wb * b.c.plane;
-            c.hop = wa * a.c.hop + wb * b.c.hop;
-            c.classify = wa * a.c.classify + wb * b.c.classify;
+            for (auto f : kCostFields) c.*f = wa * a.c.*f + wb * b.c.*f;
             for (int k = 0; k < kPrimKinds; ++k) c.prim[k] = wa * a.c.prim[k] + wb * b.c.prim[k];
-            c.steps = wa * a.c.steps + wb * b.c.steps;
-            c.leaves = wa * a.c.leaves + wb * b.c.leaves;
-            c.empty_leaves = wa * a.c.empty_leaves + wb * b.c.empty_leaves;
             leaf_visits = wa * a.leaf_visits + wb * b.leaf_visits;
             dlo = slot(lo);
             dhi = std::max({dlo, a.dhi, b.dhi});
@@ -677,14 +667,7 @@ private:
         }
         /// this += w * o (o's depths start at or below this one's).
         void add(const Sums& o, double w) {
-            c.box += w * o.c.box;
-            c.plane += w * o.c.plane;
-            c.hop += w * o.c.hop;
-            c.classify += w * o.c.classify;
-            for (int k = 0; k < kPrimKinds; ++k) c.prim[k] += w * o.c.prim[k];
-            c.steps += w * o.c.steps;
-            c.leaves += w * o.c.leaves;
-            c.empty_leaves += w * o.c.empty_leaves;
+            add_scaled(c, o.c, w);
             leaf_visits += w * o.leaf_visits;
             extend(o.dhi);
             for (int d = o.dlo; d < o.dhi; ++d) depth[d] += w * o.depth[d];

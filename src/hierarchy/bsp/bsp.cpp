@@ -1,5 +1,6 @@
 // `bsp`: the build, structure statistics, the model tree and the registration.
 #include "bsp.hpp"
+#include "../common/tree_stats.hpp"
 
 #include <algorithm>
 
@@ -63,20 +64,7 @@ void Bsp::build(std::uint32_t node, const Box3& cell, int depth, std::vector<std
 }
 
 StructureStats Bsp::compute_structure() const {
-    StructureStats s;
-    std::vector<int> depth(nodes_.size(), 0);  // children always follow their parent
-    for (std::size_t i = 0; i < nodes_.size(); ++i) {
-        const Node& n = nodes_[i];
-        if (n.leaf()) {
-            ++s.leaves;
-            s.empty_leaves += n.count == 0;
-            s.references += n.count;
-            s.depth = std::max(s.depth, depth[i]);
-        } else {
-            ++s.interior;
-            depth[n.index] = depth[n.index + 1] = depth[i] + 1;
-        }
-    }
+    StructureStats s = tree_structure(nodes_, [](const Node& n) { return n.leaf(); }, [](const Node&) { return 2u; });
     s.bytes = nodes_.size() * sizeof(Node) + refs_.size() * sizeof(std::uint32_t);
     return s;
 }

@@ -1,6 +1,7 @@
 // BVH family: structure statistics, the model-tree walk and the registrations of the three
 // builders.
 #include "bvh.hpp"
+#include "../common/tree_stats.hpp"
 
 namespace rtcost::bvh {
 
@@ -12,21 +13,8 @@ PrimInfo::PrimInfo(const Scene& s) : bounds(s.size()), centroids(s.size()) {
 }
 
 StructureStats Bvh::compute_structure() const {
-    StructureStats s;
-    // Depth by a walk from the root; children are always stored after their parent.
-    std::vector<int> depth(d_.nodes.size(), 0);
-    for (std::size_t i = 0; i < d_.nodes.size(); ++i) {
-        const Node& n = d_.nodes[i];
-        if (n.leaf) {
-            ++s.leaves;
-            s.empty_leaves += n.count == 0;
-            s.references += n.count;
-            s.depth = std::max(s.depth, depth[i]);
-        } else {
-            ++s.interior;
-            for (std::uint32_t k = 0; k < n.count; ++k) depth[n.index + k] = depth[i] + 1;
-        }
-    }
+    StructureStats s = tree_structure(
+        d_.nodes, [](const Node& n) { return n.leaf != 0; }, [](const Node& n) { return std::uint32_t(n.count); });
     s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t);
     return s;
 }

@@ -1,6 +1,7 @@
 // kd-trees: the build driver shared by both plane choosers, structure statistics, the model
 // tree and the registrations of `kd-median` and `kd-sah`.
 #include "kdtree.hpp"
+#include "../common/tree_stats.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -107,20 +108,7 @@ KdData build_tree(const Scene& s, const BuildOptions& o, const Chooser& choose) 
 }
 
 StructureStats KdTree::compute_structure() const {
-    StructureStats s;
-    std::vector<int> depth(d_.nodes.size(), 0);  // children always follow their parent
-    for (std::size_t i = 0; i < d_.nodes.size(); ++i) {
-        const Node& n = d_.nodes[i];
-        if (n.leaf()) {
-            ++s.leaves;
-            s.empty_leaves += n.count == 0;
-            s.references += n.count;
-            s.depth = std::max(s.depth, depth[i]);
-        } else {
-            ++s.interior;
-            depth[n.index] = depth[n.index + 1] = depth[i] + 1;
-        }
-    }
+    StructureStats s = tree_structure(d_.nodes, [](const Node& n) { return n.leaf(); }, [](const Node&) { return 2u; });
     s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + d_.boxes.size() * sizeof(Box3);
     return s;
 }

@@ -1,5 +1,6 @@
 // `octree`: the build, structure statistics, the model tree and the registration.
 #include "octree.hpp"
+#include "../common/tree_stats.hpp"
 
 #include <algorithm>
 
@@ -51,20 +52,7 @@ void Octree::build(std::uint32_t node, const Box3& cell, int depth, std::vector<
 }
 
 StructureStats Octree::compute_structure() const {
-    StructureStats s;
-    std::vector<int> depth(nodes_.size(), 0);  // children always follow their parent
-    for (std::size_t i = 0; i < nodes_.size(); ++i) {
-        const Node& n = nodes_[i];
-        if (n.leaf()) {
-            ++s.leaves;
-            s.empty_leaves += n.count == 0;
-            s.references += n.count;
-            s.depth = std::max(s.depth, depth[i]);
-        } else {
-            ++s.interior;
-            for (int k = 0; k < 8; ++k) depth[n.index + k] = depth[i] + 1;
-        }
-    }
+    StructureStats s = tree_structure(nodes_, [](const Node& n) { return n.leaf(); }, [](const Node&) { return 8u; });
     s.bytes = nodes_.size() * sizeof(Node) + refs_.size() * sizeof(std::uint32_t);
     return s;
 }
