@@ -81,30 +81,6 @@ struct ModelOptions {
     Query query = Query::Closest;
 };
 
-/// Per-node probabilities that drive the recursion.
-struct NodeProbabilities {
-    // Floats: one per node of trees with millions of nodes, and probabilities need no more.
-    float handed = 0;  ///< segments handed to the node (sampled) or pi (geometric)
-    float alpha = 0, beta = 0, gamma = 0.5;  ///< left only, right only, left first when both
-    /// Both children met: 1 - alpha - beta for a plane split; less for bounding volumes, whose
-    /// children need not cover their parent.
-    float both = 0;
-    float p_hit = 0;   ///< P: the segment handed to the node hits inside its region
-    /// P where the recursion uses it: among segments that meet both children of the parent
-    /// with this node first (sampled estimator; negative: use p_hit).
-    float p_first = -1;
-    float p_bv = 1;    ///< the segment meets the node's bounding volume (when it has one)
-    /// A child of a node without a plane split: the share of the parent's visits that entered
-    /// it, counted by the sampled estimator's probe.
-    float entered = -1;
-    /// With `ordered`: expected primitive tests per visit of a leaf, by kind, when the search
-    /// may stop inside it (5D candidates searched in order; sampled: an any-hit query's leaves).
-    std::array<float, kPrimKinds> tests{};
-    bool ordered = false;
-    bool split = false;  ///< alpha, beta, gamma hold for this two-child node
-};
-static_assert(sizeof(NodeProbabilities) == 56);
-
 /// A prediction: the cost vector, its scalar, and visit probabilities per model depth.
 struct Prediction {
     CostVector cost;

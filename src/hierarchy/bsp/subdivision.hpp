@@ -52,13 +52,7 @@ inline bool hardly_separates(const std::array<std::size_t, 8>& counts, std::size
     return static_cast<double>(sum) >= growth * static_cast<double>(n);
 }
 
-/// Half `side` (0 low, 1 high) of `b` cut at `s` on `axis`.
-inline Box3 half(const Box3& b, int axis, float s, int side) {
-    Box3 c = b;
-    if (side) c.lo[axis] = s;
-    else c.hi[axis] = s;
-    return c;
-}
+using spatial::half;
 
 /// Octant `k` of `b` around `c` (bit 0: high x, bit 1: high y, bit 2: high z).
 inline Box3 octant(const Box3& b, Vec3 c, int k) {

@@ -9,6 +9,14 @@
 
 namespace rtcost::spatial {
 
+/// Half `side` (0 low, 1 high) of `b` cut at `s` on `axis`.
+inline Box3 half(const Box3& b, int axis, float s, int side) {
+    Box3 c = b;
+    if (side) c.lo[axis] = s;
+    else c.hi[axis] = s;
+    return c;
+}
+
 /// How primitives are assigned to cells.
 enum class Assign {
     Bounds,  ///< every cell the primitive's bounding box overlaps (closed intervals)

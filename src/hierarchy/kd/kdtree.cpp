@@ -42,9 +42,7 @@ struct Builder {
         if (sp.axis < 0) return leaf(node, refs);
         const int a = sp.axis;
         const float x = sp.pos;
-        Box3 lcell = cell, rcell = cell;
-        lcell.hi[a] = x;
-        rcell.lo[a] = x;
+        const Box3 lcell = spatial::half(cell, a, x, 0), rcell = spatial::half(cell, a, x, 1);
         std::vector<BuildRef> left, right;
         left.reserve(refs.size());
         right.reserve(refs.size());
@@ -142,11 +140,8 @@ bool KdTree::emit_model(ModelSink& sink) const {
             m.box = 1;
         }
         sink.node(m, {});
-        Box3 l = region, r = region;
-        l.hi[n.axis] = n.split;
-        r.lo[n.axis] = n.split;
-        self(self, n.index, l);
-        self(self, n.index + 1, r);
+        for (int side = 0; side < 2; ++side)
+            self(self, n.index + side, spatial::half(region, static_cast<int>(n.axis), n.split, side));
     };
     emit(emit, 0, d_.root);
     return true;
