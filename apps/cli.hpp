@@ -28,13 +28,15 @@ struct Common {
 void add_common(CLI::App* cmd, Common& common, bool with_json = true);
 
 /// Loads a scene (path or builtin:NAME[:level]) and prints its warnings unless quiet or JSON.
-Scene load(const std::string& spec, const Common& common);
+Scene load(const std::string& spec, const Common& common, const ViewSpec& view = {});
 
 /// "7381 spheres, 1 polygon".
 std::string kind_summary(const Scene& s);
 
 /// Text listing of every hierarchy and its parameters with defaults; shown by `--help`.
 std::string hierarchy_help();
+/// One line naming every hierarchy, for subcommands' `--help` (`rtcost list` has the table).
+std::string hierarchy_footer();
 
 struct BuildArgs {
     std::string scene;
@@ -47,6 +49,8 @@ std::unique_ptr<Hierarchy> build(const Scene& scene, const BuildArgs& a, const C
 
 /// --rays, --size, --count, --seed into `spec`.
 void add_ray_args(CLI::App* cmd, RaySpec& spec);
+/// --camera and --light into `view`.
+void add_view_args(CLI::App* cmd, ViewSpec& view);
 
 /// Parses --query.
 Query parse_query(const std::string& q);

@@ -28,6 +28,13 @@ void add_ray_args(CLI::App* cmd, RaySpec& spec) {
     cmd->add_option("--size", spec.size, "image size WxH for camera-based rays (default: the scene's)");
     cmd->add_option("--count", spec.count, "number of rays for lines and random")->capture_default_str();
     cmd->add_option("--seed", spec.seed, "seed for random distributions")->capture_default_str();
+    add_view_args(cmd, spec.view);
+}
+
+void add_view_args(CLI::App* cmd, ViewSpec& view) {
+    cmd->add_option("--camera", view.camera, "camera for camera-based rays: fx,fy,fz,ax,ay,az,ux,uy,uz,fov (from, at, "
+                                             "up, full field of view in degrees); default the scene's");
+    cmd->add_option("--light", view.lights, "a positional light x,y,z (repeatable; replaces the scene's lights)");
 }
 
 Query parse_query(const std::string& q) { return q == "any" ? Query::Any : q == "all" ? Query::All : Query::Closest; }
@@ -44,9 +51,10 @@ void print_warnings(const Scene& scene, bool quiet) {
 }
 }  // namespace
 
-Scene load(const std::string& spec, const Common& common) {
+Scene load(const std::string& spec, const Common& common, const ViewSpec& view) {
     Scene scene = load_scene(spec);
     print_warnings(scene, common.quiet || common.json);
+    apply_view(scene, view);
     return scene;
 }
 
@@ -69,6 +77,12 @@ std::string hierarchy_help() {
             out += fmt::format("      {:<22} {}\n", p.name + "=" + p.default_value, p.help);
     }
     return out;
+}
+
+std::string hierarchy_footer() {
+    std::string names;
+    for (const HierarchyInfo* h : hierarchies()) names += (names.empty() ? "" : ", ") + h->name;
+    return "Hierarchies: " + names + ".\n`rtcost list` prints each one's parameters with their defaults.";
 }
 
 void add_build_args(CLI::App* cmd, BuildArgs& a) {

@@ -1,7 +1,10 @@
 // `rtcost calibrate`: fit nanoseconds per operation kind to measured single-thread times.
+#include <algorithm>
 #include <iostream>
+#include <map>
 
 #include "cli.hpp"
+#include "rtcost/evaluate.hpp"
 #include "rtcost/model.hpp"
 
 namespace rtcost::cli {
@@ -14,28 +17,39 @@ struct CalibrateArgs {
     RaySpec rays;
     int repeat = 3;
     std::string out = "costs.json";
+    std::vector<std::string> held_out;  ///< scenes measured and predicted, not fitted
 };
 
+/// Spearman's rank correlation of x and y (no ties expected of timings).
+double spearman(const std::vector<double>& x, const std::vector<double>& y) {
+    auto ranks = [](const std::vector<double>& v) {
+        std::vector<std::size_t> idx(v.size());
+        for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+        std::sort(idx.begin(), idx.end(), [&](auto a, auto b) { return v[a] < v[b]; });
+        std::vector<double> r(v.size());
+        for (std::size_t k = 0; k < idx.size(); ++k) r[idx[k]] = static_cast<double>(k);
+        return r;
+    };
+    const std::size_t n = x.size();
+    if (n < 2) return 0;
+    const auto rx = ranks(x), ry = ranks(y);
+    double d2 = 0;
+    for (std::size_t i = 0; i < n; ++i) d2 += (rx[i] - ry[i]) * (rx[i] - ry[i]);
+    return 1 - 6 * d2 / (static_cast<double>(n) * (static_cast<double>(n) * n - 1));
+}
+
 int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
-    std::vector<std::string> names;
-    if (a.hierarchies == "all") {
-        for (const HierarchyInfo* h : hierarchies())
-            if (h->name != "embree") names.push_back(h->name);  // Embree's operations are not counted
-    } else {
-        std::size_t start = 0;
-        while (start <= a.hierarchies.size()) {
-            std::size_t comma = std::min(a.hierarchies.find(',', start), a.hierarchies.size());
-            if (comma > start) names.push_back(a.hierarchies.substr(start, comma - start));
-            start = comma + 1;
-        }
-    }
-    std::vector<CalibrationSample> samples;
-    Progress progress("calibrate", a.scenes.size() * names.size(), common.quiet || common.json);
-    for (const std::string& spec : a.scenes) {
-        Scene scene = load(spec, common);
+    const std::vector<HierarchyRequest> names = parse_hierarchy_list(a.hierarchies, 0);
+    std::vector<CalibrationSample> samples, held;
+    std::vector<std::string> held_scene;
+    const std::size_t total = (a.scenes.size() + a.held_out.size()) * names.size();
+    Progress progress("calibrate", total, common.quiet || common.json);
+    auto measure = [&](const std::string& spec, std::vector<CalibrationSample>& into, std::vector<std::string>* scene_of) {
+        Scene scene = load(spec, common, a.rays.view);
         RaySet rays = make_rays(scene, a.rays);
-        for (const std::string& name : names) {
-            auto h = build_hierarchy(scene, name);
+        for (const HierarchyRequest& req : names) {
+            auto h = build_hierarchy(scene, req.name, req.params);
+            if (!h->counted()) continue;  // Embree's operations are not counted
             TraceOptions opt;
             opt.threads = 1;  // unit costs are single-thread figures
             // The fastest of several runs: the least disturbed by the machine (and, for lazily
@@ -45,16 +59,31 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
             opt.count = true;
             TraceResult counted = trace_ray_set(*h, rays, opt);
             CalibrationSample s;
-            s.label = name + " on " + scene.name;
+            s.label = req.label() + " on " + scene.name;
             s.ops = measured_cost(counted.counters);
             s.ns_per_ray = rays.rays.empty() ? 0.0 : best * 1e9 / rays.rays.size();
-            samples.push_back(std::move(s));
-            progress.update(samples.size());
+            into.push_back(std::move(s));
+            if (scene_of) scene_of->push_back(scene.name);
+            progress.update(samples.size() + held.size());
         }
-    }
+    };
+    for (const std::string& spec : a.scenes) measure(spec, samples, nullptr);
+    for (const std::string& spec : a.held_out) measure(spec, held, &held_scene);
     progress.finish();
     Calibration c = calibrate(samples);
     write_costs(a.out, c, samples);
+    // Held-out scenes: predicted time from the fitted costs against measured time, and per
+    // scene the rank agreement of the hierarchies by predicted and by measured time.
+    std::vector<double> held_pred;
+    for (const CalibrationSample& h : held) held_pred.push_back(c.costs.scalar(h.ops));
+    std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> by_scene;
+    for (std::size_t i = 0; i < held.size(); ++i) {
+        by_scene[held_scene[i]].first.push_back(held_pred[i]);
+        by_scene[held_scene[i]].second.push_back(held[i].ns_per_ray);
+    }
+    double held_mae = 0;
+    for (std::size_t i = 0; i < held.size(); ++i) held_mae += std::fabs(held_pred[i] - held[i].ns_per_ray) / held[i].ns_per_ray;
+    if (!held.empty()) held_mae /= held.size();
 
     static const char* kKinds[] = {"box", "plane", "hop", "classify"};
     if (common.json) {
@@ -68,10 +97,17 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
             runs.push_back({{"run", samples[i].label}, {"measured_ns_per_ray", samples[i].ns_per_ray},
                             {"fitted_ns_per_ray", c.predicted[i]},
                             {"residual", (c.predicted[i] - samples[i].ns_per_ray) / samples[i].ns_per_ray}});
-        std::cout << json{{"costs_file", a.out}, {"ns_per_operation", fit}, {"rms_relative_residual", c.rms_relative},
-                          {"runs", runs}}
-                         .dump(2)
-                  << "\n";
+        json held_runs = json::array(), rho = json::object();
+        for (std::size_t i = 0; i < held.size(); ++i)
+            held_runs.push_back({{"run", held[i].label}, {"measured_ns_per_ray", held[i].ns_per_ray},
+                                 {"predicted_ns_per_ray", held_pred[i]},
+                                 {"error", (held_pred[i] - held[i].ns_per_ray) / held[i].ns_per_ray}});
+        for (const auto& [scene, v] : by_scene) rho[scene] = spearman(v.first, v.second);
+        json out = {{"costs_file", a.out}, {"ns_per_operation", fit}, {"rms_relative_residual", c.rms_relative},
+                    {"runs", runs}};
+        if (!held.empty())
+            out["held_out"] = {{"runs", held_runs}, {"mean_absolute_error", held_mae}, {"spearman_by_scene", rho}};
+        std::cout << out.dump(2) << "\n";
         return 0;
     }
     fmt::print("unit costs (ns per operation, single thread), fitted over {} runs:\n", samples.size());
@@ -87,6 +123,17 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         fmt::print("{:<36} {:>12.1f} {:>12.1f} {:>+8.1f}%\n", samples[i].label, samples[i].ns_per_ray, c.predicted[i],
                    100 * (c.predicted[i] - samples[i].ns_per_ray) / samples[i].ns_per_ray);
     fmt::print("\nrms relative residual {:.1f}%; written to {} (use with eval --costs)\n", 100 * c.rms_relative, a.out);
+    if (!held.empty()) {
+        fmt::print("\nheld out (measured, not fitted):\n{:<36} {:>12} {:>12} {:>9}\n", "run", "measured ns", "predicted ns",
+                   "error");
+        for (std::size_t i = 0; i < held.size(); ++i)
+            fmt::print("{:<36} {:>12.1f} {:>12.1f} {:>+8.1f}%\n", held[i].label, held[i].ns_per_ray, held_pred[i],
+                       100 * (held_pred[i] - held[i].ns_per_ray) / held[i].ns_per_ray);
+        fmt::print("mean absolute error {:.1f}%\n", 100 * held_mae);
+        for (const auto& [scene, v] : by_scene)
+            fmt::print("rank agreement on {} (Spearman's rho, predicted against measured time): {:.3f}\n", scene,
+                       spearman(v.first, v.second));
+    }
     return 0;
 }
 
@@ -97,13 +144,14 @@ Subcommand setup_calibrate(CLI::App& parent, Common& common) {
                                       "fit nanoseconds per operation kind (least squares over measured counts and "
                                       "single-thread times) and write a costs file for eval --costs");
     cmd->add_option("SCENES", a->scenes, "scenes to measure on")->capture_default_str();
-    cmd->add_option("-H,--hierarchy", a->hierarchies, "comma-separated hierarchies, or all (but embree)")
+    cmd->add_option("-H,--hierarchy", a->hierarchies, "comma-separated hierarchies (name[:key=value...]), or all")
         ->capture_default_str();
     add_ray_args(cmd, a->rays);
     cmd->add_option("--repeat", a->repeat, "timed runs per hierarchy and scene (the fastest counts)")
         ->check(CLI::Range(1, 100))
         ->capture_default_str();
     cmd->add_option("-o,--out", a->out, "costs file to write")->capture_default_str();
+    cmd->add_option("--held-out", a->held_out, "scenes measured and predicted with the fitted costs, not fitted (repeatable)");
     add_common(cmd, common);
     return {cmd, [a, &common] { return cmd_calibrate(*a, common); }};
 }

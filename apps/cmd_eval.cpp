@@ -16,12 +16,14 @@ struct EvalArgs {
     std::string query = "closest";
     std::string shadow = "any";
     int threads = 0;
-    std::string estimator = "geometric";
+    std::string estimator = "segments";
     std::string preset = "exact";
     std::size_t sample = 0;
     std::string sample_file;
     std::string costs;
     bool by_depth = false;
+    int repeat = 0;
+    int timing_threads = 1;
 };
 
 /// "both" (sampled, geometric), "all", or a comma-separated list; the first is the headline.
@@ -43,7 +45,7 @@ std::vector<Estimator> parse_estimators(const std::string& list) {
 }
 
 int cmd_eval(EvalArgs& a, const Common& common) {
-    Scene scene = load(a.scene, common);
+    Scene scene = load(a.scene, common, a.rays.view);
     EvalOptions opt;
     opt.costs = a.costs.empty() ? UnitCosts{} : UnitCosts::read(a.costs);
     opt.hierarchies = parse_hierarchy_list(a.hierarchies, scene.size());
@@ -63,16 +65,34 @@ int cmd_eval(EvalArgs& a, const Common& common) {
     opt.sample_file = a.sample_file;
     opt.sample_seed = a.rays.seed;
     opt.threads = a.threads;
-    Progress progress("eval", opt.hierarchies.size(), common.quiet || common.json);
-    std::size_t done = 0;
-    opt.on_row = [&](const EvalRow&) { progress.update(++done); };
+    opt.timing_threads = a.timing_threads;
+    opt.repeat = a.repeat;
+    // Each step of each hierarchy is named on a terminal while it runs (trace passes with the
+    // time left), and each row is printed as it finishes, so an interrupted run keeps what it
+    // measured.
+    Progress progress("eval", 0, common.quiet || common.json);
+    opt.on_step = [&](const std::string& step) { progress.note(step); };
+    opt.on_progress = [&](const std::string& step, std::size_t done, std::size_t total) {
+        if (done == 0 || done == total) progress.restart(step, total);
+        progress.update(done);
+    };
+    bool first = true;
+    if (!common.json)
+        fmt::print("scene {} ({} primitives: {})\n", scene.name, scene.size(), kind_summary(scene));
+    opt.on_row = [&](const EvalRow& row) {
+        progress.finish();
+        if (common.json) return;
+        if (first) std::cout << eval_columns();
+        first = false;
+        std::cout << eval_row(row) << std::flush;
+    };
     const EvalResult r = evaluate(scene, a.rays, opt);
     progress.finish();
     if (common.json) {
         std::cout << to_json(r, a.by_depth).dump(2) << "\n";
         return 0;
     }
-    std::cout << eval_table(r, a.by_depth);
+    std::cout << "\n" << eval_header(r) << eval_summary(r, a.by_depth);
     return 0;
 }
 
@@ -104,9 +124,16 @@ Subcommand setup_eval(CLI::App& parent, Common& common) {
     eval->add_option("--sample-file", a->sample_file, "the segments estimator's sample, from rtcost sample");
     eval->add_option("--costs", a->costs, "unit costs file (JSON, from rtcost calibrate)");
     eval->add_flag("--by-depth", a->by_depth, "predicted and measured visits per depth");
-    eval->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024));
+    eval->add_option("--repeat", a->repeat,
+                     "timed passes over the test rays (default: as many as take 0.2 s); the median is reported")
+        ->check(CLI::Range(0, 10000));
+    eval->add_option("--timing-threads", a->timing_threads, "threads of the timed passes (ns/ray is CPU time per ray)")
+        ->check(CLI::Range(1, 1024))
+        ->capture_default_str();
+    eval->add_option("-j,--threads", a->threads, "threads of the counting passes (0: all cores)")
+        ->check(CLI::Range(0, 1024));
     add_common(eval, common);
-    eval->footer(hierarchy_help());
+    eval->footer(hierarchy_footer());
     return {eval, [a, &common] { return cmd_eval(*a, common); }};
 }
 

@@ -53,10 +53,30 @@ int cmd_build(const BuildArgs& a, const Common& common) {
     return 0;
 }
 
-int cmd_list() {
+int cmd_list(const Common& common) {
+    if (common.json) {
+        json hs = json::array();
+        for (const HierarchyInfo* h : hierarchies()) {
+            json params = json::array();
+            for (const ParamSpec& p : h->params)
+                params.push_back({{"name", p.name}, {"default", p.default_value}, {"help", p.help}});
+            hs.push_back({{"name", h->name}, {"description", h->description}, {"params", params}});
+        }
+        json scenes = json::array();
+        for (const BuiltinInfo& b : builtin_scenes())
+            scenes.push_back({{"name", "builtin:" + b.name},
+                              {"levels", {{"min", b.min_level}, {"max", b.max_level}, {"default", b.default_level}}}});
+        json dists = distribution_names();
+        std::cout << json{{"hierarchies", hs}, {"builtin_scenes", scenes}, {"distributions", dists}}.dump(2) << "\n";
+        return 0;
+    }
     fmt::print("{}", hierarchy_help());
     fmt::print("Built-in scenes (SCENE = builtin:NAME[:level]):\n");
-    for (const auto& n : builtin_scene_names()) fmt::print("  {}\n", n);
+    for (const BuiltinInfo& b : builtin_scenes())
+        fmt::print("  {:<8} levels {}..{}, default {}\n", b.name, b.min_level, b.max_level, b.default_level);
+    std::string names;
+    for (const auto& n : distribution_names()) names += (names.empty() ? "" : ", ") + n;
+    fmt::print("Ray distributions (--rays NAME, or a ray file): {}\n", names);
     return 0;
 }
 
@@ -74,13 +94,14 @@ Subcommand setup_build(CLI::App& parent, Common& common) {
     auto* cmd = parent.add_subcommand("build", "build a hierarchy and print its structural statistics");
     add_build_args(cmd, *a);
     add_common(cmd, common);
-    cmd->footer(hierarchy_help());
+    cmd->footer(hierarchy_footer());
     return {cmd, [a, &common] { return cmd_build(*a, common); }};
 }
 
-Subcommand setup_list(CLI::App& parent, Common&) {
-    auto* cmd = parent.add_subcommand("list", "list hierarchies with their parameters, and built-in scenes");
-    return {cmd, [] { return cmd_list(); }};
+Subcommand setup_list(CLI::App& parent, Common& common) {
+    auto* cmd = parent.add_subcommand("list", "list hierarchies with their parameters, built-in scenes and ray distributions");
+    add_common(cmd, common);
+    return {cmd, [&common] { return cmd_list(common); }};
 }
 
 const CommandRegistration reg_info{10, setup_info};

@@ -18,7 +18,7 @@ struct RaysArgs {
 };
 
 int cmd_rays(const RaysArgs& a, const Common& common) {
-    Scene scene = load(a.scene, common);
+    Scene scene = load(a.scene, common, a.spec.view);
     auto start = std::chrono::steady_clock::now();
     RaySet set;
     if (is_tree_distribution(a.spec.name)) {
@@ -66,12 +66,14 @@ Subcommand setup_rays(CLI::App& parent, Common& common) {
     cmd->add_option("SCENE", a->scene, "scene file or builtin:NAME[:level]")->required();
     std::string names;
     for (const auto& n : distribution_names()) names += (names.empty() ? "" : ", ") + n;
-    cmd->add_option("-d,--dist", a->spec.name, "distribution (" + names + ") or a ray file")->capture_default_str();
+    cmd->add_option("-r,--rays,-d,--dist", a->spec.name, "distribution (" + names + ") or a ray file")
+        ->capture_default_str();
     cmd->add_option("-o,--out", a->out, "write the rays here (8 float32 per ray); without it, only the counts");
     cmd->add_option("--size", a->spec.size,
                     "image size WxH (spd: 512x512, eye rays through its (W+1)x(H+1) corners; others: the scene's)");
     cmd->add_option("--count", a->spec.count, "number of rays for lines and random")->capture_default_str();
     cmd->add_option("--seed", a->spec.seed, "seed for random distributions")->capture_default_str();
+    add_view_args(cmd, a->spec.view);
     cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
     add_common(cmd, common);
     cmd->footer("Ray kinds in the counts: eye, reflection, refraction, shadow (hits of shadow rays are occluded\n"

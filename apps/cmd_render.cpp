@@ -15,10 +15,11 @@ struct RenderArgs {
     std::string size;
     int depth = 5;
     int threads = 0;
+    ViewSpec view;
 };
 
 int cmd_render(const RenderArgs& a, const Common& common) {
-    Scene scene = load(a.b.scene, common);
+    Scene scene = load(a.b.scene, common, a.view);
     RenderOptions opt;
     opt.width = scene.camera.width;
     opt.height = scene.camera.height;
@@ -57,10 +58,11 @@ Subcommand setup_render(CLI::App& parent, Common& common) {
     add_build_args(cmd, a->b);
     cmd->add_option("-o,--out", a->out, "PNG file to write")->capture_default_str();
     cmd->add_option("--size", a->size, "image size WxH (default: the scene's resolution)");
+    add_view_args(cmd, a->view);
     cmd->add_option("--depth", a->depth, "maximum ray tree depth (eye ray: 1)")->check(CLI::Range(1, 64))->capture_default_str();
     cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
     add_common(cmd, common);
-    cmd->footer(hierarchy_help());
+    cmd->footer(hierarchy_footer());
     return {cmd, [a, &common] { return cmd_render(*a, common); }};
 }
 

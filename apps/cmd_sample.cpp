@@ -19,7 +19,7 @@ struct SampleArgs {
 };
 
 int cmd_sample(SampleArgs& a, const Common& common) {
-    Scene scene = load(a.scene, common);
+    Scene scene = load(a.scene, common, a.rays.view);
     if (a.count == 0) throw InputError("--count", 0, "a sample needs at least one ray");
     // Any exact hierarchy finds the same ends; the SAH BVH is quick to build and to trace.
     auto reference = build(scene, BuildArgs{a.scene, "bvh-sah", {}}, common);
@@ -66,6 +66,7 @@ Subcommand setup_sample(CLI::App& parent, Common& common) {
         ->capture_default_str();
     cmd->add_option("--seed", a->rays.seed, "seed of the distribution and of the draw")->capture_default_str();
     cmd->add_option("-o,--out", a->out, "sample file to write")->required();
+    add_view_args(cmd, a->rays.view);
     cmd->add_option("--query", a->query, "query of the rays that are not occlusion rays: closest, any or all")
         ->check(CLI::IsMember({"closest", "any", "all"}))
         ->capture_default_str();

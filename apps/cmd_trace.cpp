@@ -19,7 +19,7 @@ struct TraceArgs {
 };
 
 int cmd_trace(const TraceArgs& a, const Common& common) {
-    Scene scene = load(a.b.scene, common);
+    Scene scene = load(a.b.scene, common, a.rays.view);
     RaySet rays = make_rays(scene, a.rays);
     auto h = build(scene, a.b, common);
     StructureStats s = h->structure();
@@ -115,7 +115,7 @@ Subcommand setup_trace(CLI::App& parent, Common& common) {
     cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
     cmd->add_flag("--no-count", a->no_count, "skip the counting pass (timing only)");
     add_common(cmd, common);
-    cmd->footer(hierarchy_help());
+    cmd->footer(hierarchy_footer());
     return {cmd, [a, &common] { return cmd_trace(*a, common); }};
 }
 

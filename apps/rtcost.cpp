@@ -11,6 +11,7 @@ int main(int argc, char** argv) {
     CLI::App app{"rtcost: build, trace, count and model ray tracing acceleration structures"};
     app.require_subcommand(1);
     app.set_help_all_flag("--help-all", "help for every subcommand");
+    app.set_version_flag("--version", std::string("rtcost ") + RTCOST_VERSION);
     Common common;
     auto registry = command_registry();
     std::stable_sort(registry.begin(), registry.end(), [](auto& x, auto& y) { return x.first < y.first; });
@@ -23,8 +24,14 @@ int main(int argc, char** argv) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {
         return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
+        return app.exit(e);
     } catch (const CLI::ParseError& e) {
-        app.exit(e);
+        // The project's error form, naming the subcommand whose --help lists the options.
+        std::string where = "rtcost";
+        for (const Subcommand& c : commands)
+            if (c.app->parsed()) where += " " + c.app->get_name();
+        fmt::print(stderr, "rtcost: error: {} (see {} --help)\n", e.what(), where);
         return kExitBadInput;
     }
 

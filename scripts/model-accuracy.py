@@ -1,11 +1,14 @@
 #!/usr/bin/env python3
 """Writes docs/model-accuracy.md: the model's predicted cost against the measured cost for every
-hierarchy and SPD scene, both estimators and both presets, and the rank agreement between
-predicted cost and measured single-thread time (Spearman's rho).
+hierarchy, scene and ray distribution, for each estimator (segments, sampled, geometric): mean and
+worst absolute error, Spearman's rho per run, the sample sizes, and each prediction's seconds
+against the seconds that tracing the whole distribution takes.
 
-Usage: python3 scripts/model-accuracy.py [--rays spd] [--scenes balls,gears,...] [--out FILE]
-Needs build/rtcost and ../shared/scenes/spd. Runs `rtcost calibrate` first for the unit costs
-that turn predicted operations into predicted time.
+Usage: python3 scripts/model-accuracy.py [--dists camera,shadow,...] [--scenes balls,...]
+       [--meshes FILE,...] [--size 256x256] [--out FILE]
+Needs build/rtcost and ../shared/scenes/spd. Counts are operations (unit costs); the test rays
+of every run are every ray of the distribution but the segments estimator's sample, and the
+sampled estimator trains on a pseudo-random half of those (so its figures are for the other half).
 """
 import argparse
 import datetime
@@ -16,8 +19,10 @@ import subprocess
 import sys
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-CLI = os.path.join(ROOT, "build", "rtcost")
+CLI = os.environ.get("RTCOST_CLI", os.path.join(ROOT, "build", "rtcost"))
 SPD = os.path.join(ROOT, "..", "shared", "scenes", "spd")
+MESHES = ["/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb"]
+ESTIMATORS = ["segments", "sampled", "geometric"]
 
 
 def run(args):
@@ -60,109 +65,116 @@ def cpu_name():
     return platform.processor() or "unknown"
 
 
-def main():
-    ap = argparse.ArgumentParser()
-    ap.add_argument("--rays", default="spd")
-    ap.add_argument("--size", default="")
-    ap.add_argument("--scenes", default="balls,gears,mount,rings,teapot,tetra,tree")
-    ap.add_argument("--hierarchies", default="")
-    ap.add_argument("--sample", default="100000")
-    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "model-accuracy.md"))
-    a = ap.parse_args()
-
-    names = [h for h in a.hierarchies.split(",") if h]
-    if not names:
-        listing = subprocess.run([CLI, "list"], capture_output=True, text=True).stdout
-        for line in listing.splitlines():
+def hierarchy_names():
+    listing = json.loads(subprocess.run([CLI, "list", "--json"], capture_output=True, text=True).stdout) \
+        if "--json" in subprocess.run([CLI, "list", "--help"], capture_output=True, text=True).stdout else None
+    names = []
+    if listing:
+        names = [h["name"] for h in listing["hierarchies"]]
+    else:
+        for line in subprocess.run([CLI, "list"], capture_output=True, text=True).stdout.splitlines():
             if line.startswith("Built-in scenes"):
                 break
             if line.startswith("  ") and not line.startswith("      "):
-                n = line.split()[0]
-                if n not in ("embree", "brute"):
-                    names.append(n)
-    costs = "/tmp/rtcost-model-accuracy-costs.json"
-    print("calibrating unit costs ...", file=sys.stderr)
-    cal = run(["calibrate", "builtin:balls:3", "builtin:tetra:5", "builtin:balls",
-               os.path.join(SPD, "rings.nff"), os.path.join(SPD, "teapot.nff"),
-               "-H", ",".join(names), "-o", costs, "-q", "--json"])
+                names.append(line.split()[0])
+    names = [n for n in names if n not in ("embree", "brute")]
+    # The lazily grown rc5d and the eagerly built one are reported apart.
+    if "rc5d" in names:
+        names.append("rc5d:build=eager:max_depth=12")
+    return names
 
-    rows, rhos = [], []
-    for scene in a.scenes.split(","):
-        path = os.path.join(SPD, scene + ".nff")
-        if not os.path.exists(path):
-            print(f"skipping {scene}: {path} not present", file=sys.stderr)
-            continue
-        print(f"eval {scene} ...", file=sys.stderr)
-        args = ["eval", path, "-H", ",".join(names), "--rays", a.rays, "--estimator", "both", "--preset", "both",
-                "--sample", a.sample, "--costs", costs, "-q", "--json"]
-        if a.size:
-            args += ["--size", a.size]
-        ev = run(args)
-        pred_time, meas_time = [], []
-        for r in ev["results"]:
-            preds = {f'{p["estimator"]}/{p["preset"]}': p for p in r["predictions"]}
-            meas = r["measured"]["cost"]
-            rows.append((scene, r["hierarchy"], meas, preds, ev["rays"]))
-            pred_time.append(preds["sampled/exact"]["cost"])
-            meas_time.append(r["time"]["measured_ns_per_ray"])
-        rhos.append((scene, spearman(pred_time, meas_time), len(pred_time)))
 
-    combos = ["sampled/exact", "sampled/paper", "geometric/exact", "geometric/paper"]
+def main():
+    ap = argparse.ArgumentParser()
+    ap.add_argument("--dists", default="camera,shadow,diffuse,ao,spd")
+    ap.add_argument("--size", default="256x256")
+    ap.add_argument("--scenes", default="balls,gears,mount,rings,teapot,tetra,tree")
+    ap.add_argument("--meshes", default=",".join(MESHES))
+    ap.add_argument("--hierarchies", default="")
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "model-accuracy.md"))
+    a = ap.parse_args()
+
+    names = [h for h in a.hierarchies.split(",") if h] or hierarchy_names()
+    scenes = []
+    for s in a.scenes.split(","):
+        path = os.path.join(SPD, s + ".nff")
+        if os.path.exists(path):
+            scenes.append((s, path))
+        else:
+            print(f"skipping {s}: {path} not present", file=sys.stderr)
+    for m in [m for m in a.meshes.split(",") if m]:
+        if os.path.exists(m):
+            scenes.append((os.path.splitext(os.path.basename(m))[0], m))
+        else:
+            print(f"skipping {m}: not present", file=sys.stderr)
+
+    rows = []   # (scene, dist, hierarchy, measured, {est: (pred, err, seconds)}, trace_seconds)
+    runs = []   # (scene, dist, rays, sample, training, {est: rho})
+    for scene, path in scenes:
+        for dist in a.dists.split(","):
+            print(f"eval {scene} {dist} ...", file=sys.stderr)
+            ev = run(["eval", path, "-H", ",".join(names), "--rays", dist, "--size", a.size,
+                      "--estimator", ",".join(ESTIMATORS), "-j", "1", "-q", "--json"])
+            population = ev["rays"] + ev["sample_rays"]
+            per_est = {e: ([], []) for e in ESTIMATORS}
+            for r in ev["results"]:
+                preds = {p["estimator"]: p for p in r["predictions"]}
+                meas = r["measured"]["cost"]
+                trace_s = r["time"]["measured_ns_per_ray"] * population / 1e9
+                rows.append((scene, dist, r["hierarchy"], meas,
+                             {e: (preds[e]["cost"], preds[e]["error"], preds[e]["seconds"]) for e in ESTIMATORS},
+                             trace_s))
+                for e in ESTIMATORS:
+                    per_est[e][0].append(preds[e]["cost"])
+                    per_est[e][1].append(meas)
+            runs.append((scene, dist, ev["rays"], ev["sample_rays"], ev["training_rays"],
+                         {e: spearman(*per_est[e]) for e in ESTIMATORS}))
+
     with open(a.out + ".tmp", "w") as f:
         f.write("# How well the model predicts\n\n")
         f.write(f"Generated by `python3 scripts/model-accuracy.py` on {datetime.date.today()} "
-                f"({cpu_name()}, {os.cpu_count()} cores). Rays: `--rays {a.rays}{' --size ' + a.size if a.size else ''}`, closest hit for eye, "
-                "reflection and refraction rays, any hit for shadow rays; the sampled estimator trains on "
-                f"up to {a.sample} rays of the same distribution, disjoint from the rays measured. Costs "
-                "are in nanoseconds per ray from unit costs fitted by `rtcost calibrate` "
-                f"(rms residual of the fit {100 * cal['rms_relative_residual']:.1f}%), so predicted and "
-                "measured cost use the same units; the error is (predicted - measured) / measured of that "
-                "scalar.\n\n")
-        if a.rays != "spd":
-            f.write(f"These figures are for `--rays {a.rays}`{' --size ' + a.size if a.size else ''}, not the SPD Whitted "
-                    "ray tree the issue asks for: the `spd` distribution is not in this build yet. Rerun with "
-                    "`--rays spd` once it is.\n\n")
-        f.write("## Predicted against measured cost per ray\n\n")
-        f.write("| scene | hierarchy | measured | " + " | ".join(combos) + " |\n")
-        f.write("|---|---|---|" + "---|" * len(combos) + "\n")
-        mae = {c: [] for c in combos}
-        for scene, h, meas, preds, n in rows:
-            cells = []
-            for c in combos:
-                p = preds[c]
-                cells.append(f'{p["cost"]:.1f} ({100 * p["error"]:+.1f}%)')
-                mae[c].append(abs(p["error"]))
-            f.write(f"| {scene} | {h} | {meas:.1f} | " + " | ".join(cells) + " |\n")
-        f.write("\n## Mean absolute error\n\n| estimator/preset | mean absolute error | runs |\n|---|---|---|\n")
-        for c in combos:
-            v = mae[c]
-            f.write(f"| {c} | {100 * sum(v) / max(1, len(v)):.1f}% | {len(v)} |\n")
-        f.write("\n## Rank agreement\n\nSpearman's rho between the hierarchies' order by predicted cost "
-                "(sampled estimator, exact preset, calibrated ns) and their order by measured single-thread "
-                "time, per scene.\n\n| scene | hierarchies | rho |\n|---|---|---|\n")
-        for scene, rho, n in rhos:
-            f.write(f"| {scene} | {n} | {rho:.3f} |\n")
-        f.write("\n## Reading the numbers\n\n"
-                "- The **sampled** estimator walks the training rays through the model tree as the "
-                "traversal would (front to back, real primitive tests, each query's rule for stopping) and "
-                "counts each node's alpha, beta, gamma, P and tests per leaf visit. On its own training rays "
-                "the recursion then gives back the traversal's counts exactly (a test checks it for every "
-                "hierarchy and query), so its error on the measured rays is sampling error: it is largest on "
-                "tree, whose rays spread over many deep nodes that few training rays reach.\n"
-                "- The **geometric** estimator assumes isotropic lines (Cauchy-Crofton) and approximates "
-                "P over several primitives by 1 - exp(-sum p_i). It is exact in expectation for lines with "
-                "no termination (tested), but SPD rays are neither isotropic nor unterminated: eye rays "
-                "share one origin, shadow rays end at lights, and a hit on a large ground polygon ends most "
-                "rays late, not early. Its errors here are reported as they are.\n"
-                "- The **paper** preset charges what the paper's formulas charge per family (a BVH child's "
-                "box only when it is entered, a BSP node the far region's entry as n_f, ...); **exact** "
-                "charges every operation the traversal performs.\n"
-                "- `rc5d` is built lazily: the geometric estimator weighs every beam by the line measure, "
-                "including beams the camera rays never reached and so never subdivided, whose candidate "
-                "lists are long. Its geometric figures describe that partly built structure under isotropic "
-                "lines, not the camera rays; the exactness test builds it eagerly.\n"
-                "- Timings (for the rank correlation) were taken on a shared 2-core machine; ranks of "
-                "hierarchies within a few percent of each other can swap from run to run.\n")
+                f"({cpu_name()}, {os.cpu_count()} cores, single-thread timings). Rays: `--size {a.size}` of "
+                f"`{a.dists}`; closest hit for eye, reflection, refraction and diffuse rays, any hit for "
+                "shadow and ambient-occlusion rays. Costs are operations per ray (unit costs); the error is "
+                "(predicted - measured) / measured.\n\n"
+                "- **segments**: one sample of 2% of the distribution's rays (at most 4,096), drawn once per "
+                "scene and distribution with `bvh-sah` as the reference, replayed through every hierarchy's "
+                "model tree with no primitive tests. The measured rays are every other ray of the "
+                "distribution.\n"
+                "- **sampled**: a probe with real primitive tests of a pseudo-random half of those rays (up to "
+                "20,000); it is measured on the other half.\n"
+                "- **geometric**: no rays at all; Cauchy-Crofton probabilities and the Poisson form of P.\n\n")
+        f.write("## Summary\n\n| estimator | mean absolute error | worst | runs | rho (min over runs) | "
+                "rho (median) |\n|---|---|---|---|---|---|\n")
+        for e in ESTIMATORS:
+            errs = [abs(r[4][e][1]) for r in rows]
+            rhos = sorted(x[5][e] for x in runs)
+            worst = max(rows, key=lambda r: abs(r[4][e][1]))
+            f.write(f"| {e} | {100 * sum(errs) / max(1, len(errs)):.1f}% | {100 * abs(worst[4][e][1]):.1f}% "
+                    f"({worst[2]} on {worst[0]} {worst[1]}) | {len(errs)} | {rhos[0]:.3f} | "
+                    f"{rhos[len(rhos) // 2]:.3f} |\n")
+        f.write("\n## Prediction time against tracing the whole distribution\n\n"
+                "Seconds of the segments prediction for one hierarchy (materialising its model tree "
+                "included; drawing the sample, once per scene and distribution, not included) over the "
+                "single-thread seconds of tracing every ray of the distribution through it.\n\n"
+                "| hierarchy | median share | worst share | worst run |\n|---|---|---|---|\n")
+        for h in names:
+            shares = sorted((r[4]["segments"][2] / r[5], r) for r in rows if r[2] == h and r[5] > 0)
+            if not shares:
+                continue
+            w = shares[-1]
+            f.write(f"| {h} | {100 * shares[len(shares) // 2][0]:.2f}% | {100 * w[0]:.2f}% | "
+                    f"{w[1][0]} {w[1][1]} |\n")
+        f.write("\n## Runs\n\n| scene | distribution | test rays | sample | training | " +
+                " | ".join(f"rho {e}" for e in ESTIMATORS) + " |\n|---|---|---|---|---|" + "---|" * len(ESTIMATORS) + "\n")
+        for scene, dist, n, smp, tr, rho in runs:
+            f.write(f"| {scene} | {dist} | {n} | {smp} ({100 * smp / (n + smp):.1f}%) | {tr} | " +
+                    " | ".join(f"{rho[e]:.3f}" for e in ESTIMATORS) + " |\n")
+        f.write("\n## Predicted against measured operations per ray\n\n| scene | distribution | hierarchy | "
+                "measured | " + " | ".join(ESTIMATORS) + " |\n|---|---|---|---|" + "---|" * len(ESTIMATORS) + "\n")
+        for scene, dist, h, meas, p, _ in rows:
+            f.write(f"| {scene} | {dist} | {h} | {meas:.1f} | " +
+                    " | ".join(f"{p[e][0]:.1f} ({100 * p[e][1]:+.1f}%)" for e in ESTIMATORS) + " |\n")
     os.replace(a.out + ".tmp", a.out)
     print(f"wrote {a.out}", file=sys.stderr)
 

@@ -6,4 +6,4 @@ cd "$(dirname "$0")/.."
 bash scripts/install-deps.sh
 bash scripts/build.sh
 ./build/rtcost info builtin:balls
-./build/rtcost eval builtin:balls --rays camera --size 256x256 --estimator sampled
+./build/rtcost eval builtin:balls --rays camera --size 256x256

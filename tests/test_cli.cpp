@@ -60,8 +60,24 @@ TEST(Cli, HelpListsSubcommandsAndHierarchyParameters) {
     CliRun t = run("trace --help");
     EXPECT_EQ(t.code, 0);
     EXPECT_NE(t.out.find("bvh-sah"), std::string::npos);
-    EXPECT_NE(t.out.find("max_prims=8"), std::string::npos);  // defaults are printed
+    EXPECT_NE(t.out.find("rtcost list"), std::string::npos);  // where the parameters are
+    EXPECT_EQ(t.out.find("max_prims=8"), std::string::npos);  // not repeated in every --help
     EXPECT_NE(t.out.find("--threads"), std::string::npos);
+    CliRun l = run("list");
+    EXPECT_EQ(l.code, 0);
+    EXPECT_NE(l.out.find("max_prims=8"), std::string::npos);  // defaults are printed
+    CliRun lj = run("list --json");
+    ASSERT_EQ(lj.code, 0);
+    auto j = nlohmann::json::parse(lj.out);
+    EXPECT_GE(j["hierarchies"].size(), 10u);
+    EXPECT_EQ(j["builtin_scenes"][0]["name"], "builtin:balls");
+    EXPECT_EQ(j["builtin_scenes"][0]["levels"]["default"], 4);
+    CliRun v = run("--version");
+    EXPECT_EQ(v.code, 0);
+    EXPECT_EQ(v.out.rfind("rtcost ", 0), 0u) << v.out;
+    CliRun bad = run("trace builtin:balls --no-such-option");
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_EQ(bad.err.rfind("rtcost: error: ", 0), 0u) << bad.err;
 }
 
 TEST(Cli, InfoJsonReportsCountsBoundsLightsCamera) {

@@ -34,8 +34,10 @@ struct HierarchyRequest {
 std::vector<HierarchyRequest> parse_hierarchy_list(std::string_view list, std::size_t primitives,
                                                    const std::string& what = "--hierarchy");
 
-/// Above this many primitives `all` leaves brute force out (ask for it by name).
+/// Above this many primitives `all` leaves brute force out (ask for it by name), and brute force
+/// asked for is measured on a subset of the rays: about kBruteTests primitive tests in all.
 inline constexpr std::size_t kBruteLimit = 5000;
+inline constexpr std::size_t kBruteTests = 200'000'000;
 
 struct EvalRow;
 
@@ -55,9 +57,17 @@ struct EvalOptions {
     std::uint64_t sample_seed = 1;
     std::string sample_file;
     UnitCosts costs;                   ///< unit costs (calibrated: ns) for the scalar cost
-    int threads = 0;                   ///< 0: all cores (1 when the costs are calibrated)
-    /// Called before each hierarchy is built ("building NAME"), and with each finished row.
+    int threads = 0;                   ///< counting passes: 0 for all cores
+    int timing_threads = 1;            ///< timed passes (single-thread by default: rankings by time)
+    /// Timed passes over the test rays: `repeat` of them, or (repeat 0) as many as add up to
+    /// `min_seconds`; the median is reported with the spread.
+    int repeat = 0;
+    double min_seconds = 0.2;
+    /// Called as each step of each hierarchy starts ("build NAME", "counting NAME", "timing
+    /// NAME", "model NAME"), with the progress of the trace passes (step, rays done, rays), and
+    /// with each finished row.
     std::function<void(const std::string& step)> on_step;
+    std::function<void(const std::string& step, std::size_t done, std::size_t total)> on_progress;
     std::function<void(const EvalRow& row)> on_row;
 };
 
@@ -68,14 +78,20 @@ struct EvalRow {
     bool modelled = false;             ///< the model sees into it (not embree)
     bool lazy = false;                 ///< grown by the rays (rc5d's default)
     std::vector<Prediction> predictions;  ///< every estimator x preset asked for; [0] the headline
+    bool counted = true;               ///< its traversal counts operations (not embree)
+    std::size_t measured_rays = 0;     ///< test rays measured (brute force on a large scene: a subset)
     CostVector measured;               ///< counted operations per ray
     double measured_scalar = 0;        ///< measured operations in unit costs
     double error = 0;                  ///< (headline - measured) / measured
-    double mrays_per_s = 0;            ///< measured speed on `threads` threads
-    double ns_per_ray = 0;             ///< measured wall time per ray x threads
+    double mrays_per_s = 0;            ///< measured speed (wall clock) on `threads` threads
+    double ns_per_ray = 0;             ///< measured CPU time per ray (median of the timed passes)
+    int repeats = 1;                   ///< timed passes
+    double time_spread = 0;            ///< (slowest - fastest) / median of the timed passes
     int threads = 1;
     std::vector<double> measured_visits;  ///< measured traversal steps per depth per ray
-    int rank_predicted = 0, rank_measured = 0;  ///< 1 = cheapest (0: not ranked)
+    /// 1 = cheapest, 0 = not ranked: by predicted cost (ns when the costs are calibrated), by
+    /// counted operations (in unit costs), and by measured time.
+    int rank_predicted = 0, rank_measured = 0, rank_time = 0;
 
     const Prediction* headline() const { return predictions.empty() ? nullptr : &predictions.front(); }
 };
@@ -110,8 +126,14 @@ EvalResult evaluate(const Scene& scene, RaySet rays, const EvalOptions& opt);
 
 /// The `rtcost eval --json` document of `r` (with `visits_by_depth` when `by_depth`).
 nlohmann::json to_json(const EvalResult& r, bool by_depth = false);
-/// The text tables `rtcost eval` prints (with visits per depth when `by_depth`).
+/// The text tables `rtcost eval` prints (with visits per depth when `by_depth`): the header
+/// (scene, rays, split, queries, model), the column names, one line per row, and the summary
+/// (rankings, every prediction, costs by kind).
 std::string eval_table(const EvalResult& r, bool by_depth = false);
+std::string eval_header(const EvalResult& r);
+std::string eval_columns();
+std::string eval_row(const EvalRow& row);
+std::string eval_summary(const EvalResult& r, bool by_depth = false);
 
 std::string_view estimator_name(Estimator e);
 std::string_view preset_name(Preset p);

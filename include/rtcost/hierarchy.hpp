@@ -177,6 +177,10 @@ public:
     /// structure() and model_tree() then describe only what the rays so far have built.
     virtual bool lazy() const { return false; }
 
+    /// False for hierarchies whose traversal cannot count its operations (embree): they are
+    /// timed, never counted or modelled.
+    virtual bool counted() const { return true; }
+
 protected:
     explicit Hierarchy(const Scene& scene) : scene_(&scene) {}
     /// Everything of StructureStats but `seconds`, which build_hierarchy measures.

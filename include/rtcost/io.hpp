@@ -32,6 +32,13 @@ Scene builtin_scene(std::string_view name, int level = -1);
 /// Names of the built-in scenes.
 std::vector<std::string> builtin_scene_names();
 
+/// A built-in scene and the levels it takes.
+struct BuiltinInfo {
+    std::string name;
+    int min_level = 0, max_level = 0, default_level = 0;
+};
+std::vector<BuiltinInfo> builtin_scenes();
+
 /// One record of a ray file: 8 little-endian float32, `ox oy oz dx dy dz tmin tmax`.
 /// Reads a whole ray file; throws InputError when its size is not a multiple of 32 bytes, or a
 /// record has a NaN, an infinite origin or direction, a zero direction, or tmin > tmax.

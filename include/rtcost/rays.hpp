@@ -47,6 +47,18 @@ struct RaySet {
     std::vector<std::pair<std::string, std::size_t>> summary;
 };
 
+/// A camera and lights given on the command line instead of the scene's: `camera` is
+/// "fx,fy,fz,ax,ay,az,ux,uy,uz,fov" (from, at, up, full field of view in degrees), each light
+/// "x,y,z". Empty: the scene's own.
+struct ViewSpec {
+    std::string camera;
+    std::vector<std::string> lights;
+};
+
+/// Replaces the scene's camera and lights by `view`'s (those it gives); throws InputError
+/// naming the option for a malformed or degenerate one.
+void apply_view(Scene& scene, const ViewSpec& view);
+
 /// How to make a ray set: `name` is a distribution (camera, lines, random, spd, shadow, diffuse,
 /// ao) or a ray file path.
 struct RaySpec {
@@ -54,6 +66,7 @@ struct RaySpec {
     std::string size;                 ///< "WxH" for camera-based distributions; empty: the scene's
     std::size_t count = 100000;       ///< rays for lines and random
     std::uint64_t seed = 1;
+    ViewSpec view;                    ///< camera and lights (see apply_view; make_rays reads the scene's)
 };
 
 /// Names accepted by make_rays besides file paths.

@@ -31,8 +31,12 @@ public:
     ~Progress();
     Progress(const Progress&) = delete;
     Progress& operator=(const Progress&) = delete;
-    /// Reports `done` of `total` units finished.
+    /// Reports `done` of `total` units finished, with the time left.
     void update(std::size_t done);
+    /// A new step of `total` units: the clock restarts.
+    void restart(std::string label, std::size_t total);
+    /// Shows `text` now (a step that reports no fraction done, such as a build).
+    void note(const std::string& text);
     void finish();
     bool active() const { return active_; }
 

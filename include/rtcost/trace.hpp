@@ -23,7 +23,10 @@ struct TraceOptions {
 struct TraceResult {
     std::vector<Hit> hits;    ///< one per ray; for Query::Any, the first hit found
     std::size_t hit_count = 0;
-    double seconds = 0;       ///< traversal alone
+    double seconds = 0;       ///< traversal alone (wall clock)
+    /// CPU time the process spent meanwhile (all threads): the work itself, which a busy
+    /// machine does not inflate as it inflates the wall clock.
+    double cpu_seconds = 0;
     int threads = 1;
     RayCounters counters;     ///< summed over all rays (when counting)
     /// For ray sets: rays, hits and counters by RayKind (indexed by the enum's value).

@@ -2,6 +2,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <ctime>
 #include <mutex>
 #include <oneapi/tbb/blocked_range.h>
 #include <oneapi/tbb/enumerable_thread_specific.h>
@@ -13,6 +14,14 @@
 namespace rtcost {
 
 int default_threads() { return tbb::info::default_concurrency(); }
+
+namespace {
+double process_cpu_seconds() {
+    timespec t{};
+    ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+    return static_cast<double>(t.tv_sec) + 1e-9 * static_cast<double>(t.tv_nsec);
+}
+}  // namespace
 
 TraceResult trace_rays(const Hierarchy& h, std::span<const Ray> rays, const TraceOptions& opt) {
     TraceResult res;
@@ -57,10 +66,12 @@ TraceResult trace_rays(const Hierarchy& h, std::span<const Ray> rays, const Trac
         else run(range, std::false_type{});
     };
     auto start = std::chrono::steady_clock::now();
+    const double cpu_start = process_cpu_seconds();
     arena.execute([&] {
         tbb::parallel_for(tbb::blocked_range<std::size_t>(0, rays.size(), kGrain), body);
     });
     res.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    res.cpu_seconds = process_cpu_seconds() - cpu_start;
     for (auto& c : local) res.counters += c;
     for (const Hit& hit : res.hits) res.hit_count += hit.hit();
     return res;
@@ -85,6 +96,7 @@ TraceResult trace_ray_set(const Hierarchy& h, const RaySet& set, const TraceOpti
         TraceResult r = trace_rays(h, batch, o);
         for (std::size_t j = 0; j < batch.size(); ++j) res.hits[index[k][j]] = r.hits[j];
         res.seconds += r.seconds;
+        res.cpu_seconds += r.cpu_seconds;
         res.hit_count += r.hit_count;
         res.counters += r.counters;
         res.rays_by_kind[k] = batch.size();

@@ -184,21 +184,62 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
     res.calibrated = costs.calibrated;
 
     for (const HierarchyRequest& req : opt.hierarchies) {
-        if (opt.on_step) opt.on_step("building " + req.label());
+        if (opt.on_step) opt.on_step("build " + req.label());
         auto h = build_hierarchy(scene, req.name, req.params);
         EvalRow row;
         row.name = req.label();
         TraceOptions to;
         to.query = opt.query;
-        // With calibrated (single-thread) unit costs, time on one thread unless told otherwise.
-        to.threads = opt.threads > 0 ? opt.threads : costs.calibrated ? 1 : 0;
+        to.threads = opt.threads;
+        // Brute force over a large scene is measured on a subset of the rays (every k-th), so
+        // that asking for it cannot take hours; the row says so.
+        const RaySet* rays = &test;
+        RaySet subset;
+        if (req.name == "brute" && scene.size() > kBruteLimit) {
+            const std::size_t keep = std::max<std::size_t>(1000, kBruteTests / scene.size());
+            if (keep < test.rays.size()) {
+                const std::size_t step = (test.rays.size() + keep - 1) / keep;
+                for (std::size_t i = 0; i < test.rays.size(); i += step) {
+                    subset.rays.push_back(test.rays[i]);
+                    subset.kinds.push_back(test.kinds[i]);
+                }
+                subset.described = test.described;
+                rays = &subset;
+            }
+        }
+        row.measured_rays = rays->rays.size();
+        auto progress = [&](const std::string& step) {
+            if (opt.on_step) opt.on_step(step + " " + req.label());
+            if (opt.on_progress) to.progress = [&, step](std::size_t done) { opt.on_progress(step, done, rays->rays.size()); };
+        };
         // Counted first, so a lazily built hierarchy (rc5d) is complete when timed.
-        if (opt.on_step) opt.on_step("counting " + req.label());
+        progress("counting");
         to.count = true;
-        TraceResult counted = trace_ray_set(*h, test, to, opt.occlusion);
-        if (opt.on_step) opt.on_step("timing " + req.label());
+        TraceResult counted = trace_ray_set(*h, *rays, to, opt.occlusion);
+        row.counted = h->counted();
+        // Timed passes: repeated until they add up to opt.min_seconds (or opt.repeat of them);
+        // the median is reported with the spread.
+        progress("timing");
         to.count = false;
-        TraceResult timed = trace_ray_set(*h, test, to, opt.occlusion);
+        to.threads = opt.timing_threads;
+        std::vector<double> seconds, cpu;
+        double total = 0;
+        int threads = 1;
+        const int max_repeats = opt.repeat > 0 ? opt.repeat : 1000;
+        while (static_cast<int>(seconds.size()) < max_repeats) {
+            const TraceResult timed = trace_ray_set(*h, *rays, to, opt.occlusion);
+            seconds.push_back(timed.seconds);
+            cpu.push_back(timed.cpu_seconds);
+            threads = timed.threads;
+            total += timed.seconds;
+            if (opt.repeat <= 0 && total >= opt.min_seconds) break;
+        }
+        std::sort(seconds.begin(), seconds.end());
+        std::sort(cpu.begin(), cpu.end());
+        const double median = seconds[seconds.size() / 2], cpu_median = cpu[cpu.size() / 2];
+        row.repeats = static_cast<int>(seconds.size());
+        row.time_spread = cpu_median > 0 ? (cpu.back() - cpu.front()) / cpu_median : 0;
+        to.progress = nullptr;
         // Structure and model tree after tracing: a lazily built hierarchy (rc5d) exists only
         // where rays went, so the training rays go through it too.
         if (sampled && h->lazy())
@@ -208,7 +249,7 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         row.lazy = h->lazy();
         row.modelled = h->modelled();
         if (row.modelled) {
-            if (opt.on_step) opt.on_step("predicting " + req.label());
+            if (opt.on_step) opt.on_step("model " + req.label());
             // The sampled estimator's probe indexes a materialised tree; the geometric one reads
             // the hierarchy where it lies.
             const bool probed = sampled || wants(opt, Estimator::Segments);
@@ -251,9 +292,9 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         row.measured_scalar = costs.scalar(row.measured);
         const Prediction* head = row.headline();
         row.error = head && row.measured_scalar > 0 ? (head->scalar - row.measured_scalar) / row.measured_scalar : 0;
-        row.mrays_per_s = timed.seconds > 0 ? test.rays.size() / timed.seconds / 1e6 : 0;
-        row.ns_per_ray = timed.seconds * 1e9 * timed.threads / test.rays.size();
-        row.threads = timed.threads;
+        row.mrays_per_s = median > 0 ? rays->rays.size() / median / 1e6 : 0;
+        row.ns_per_ray = cpu_median * 1e9 / rays->rays.size();
+        row.threads = threads;
         const double n = counted.counters.rays ? static_cast<double>(counted.counters.rays) : 1;
         for (int d = 0; d < kMaxStatDepth; ++d) row.measured_visits.push_back(counted.counters.visits[d] / n);
         while (!row.measured_visits.empty() && row.measured_visits.back() == 0) row.measured_visits.pop_back();
@@ -261,7 +302,8 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         res.rows.push_back(std::move(row));
     }
     rank(res.rows, [](const EvalRow& r) { return r.modelled ? r.headline()->scalar : kInf; }, &EvalRow::rank_predicted);
-    rank(res.rows, [](const EvalRow& r) { return r.measured_scalar; }, &EvalRow::rank_measured);
+    rank(res.rows, [](const EvalRow& r) { return r.counted ? r.measured_scalar : kInf; }, &EvalRow::rank_measured);
+    rank(res.rows, [](const EvalRow& r) { return r.ns_per_ray; }, &EvalRow::rank_time);
     return res;
 }
 

@@ -1,6 +1,8 @@
 // Named ray distributions: the one place that turns `--rays NAME` into rays.
 #include <fmt/format.h>
 
+#include <charconv>
+#include <cmath>
 #include <filesystem>
 
 #include "rtcost/error.hpp"
@@ -39,6 +41,54 @@ RaySet uniform(std::vector<Ray> rays, RayKind kind, std::string described) {
     return set;
 }
 }  // namespace
+
+namespace {
+/// Comma-separated finite numbers, exactly `n` of them.
+std::vector<float> numbers(const std::string& text, std::size_t n, const std::string& what) {
+    std::vector<float> out;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        std::size_t comma = std::min(text.find(',', start), text.size());
+        const std::string item = text.substr(start, comma - start);
+        start = comma + 1;
+        float v = 0;
+        auto [end, ec] = std::from_chars(item.data(), item.data() + item.size(), v);
+        if (item.empty() || ec != std::errc() || end != item.data() + item.size() || !std::isfinite(v))
+            throw InputError(what, 0, "'" + text.substr(0, 80) + "': expected " + std::to_string(n) +
+                                          " comma-separated finite numbers");
+        out.push_back(v);
+    }
+    if (out.size() != n)
+        throw InputError(what, 0, "'" + text.substr(0, 80) + "': expected " + std::to_string(n) + " numbers, got " +
+                                      std::to_string(out.size()));
+    return out;
+}
+}  // namespace
+
+void apply_view(Scene& scene, const ViewSpec& view) {
+    if (!view.camera.empty()) {
+        const std::vector<float> v = numbers(view.camera, 10, "--camera");
+        Camera c = scene.camera;
+        c.from = {v[0], v[1], v[2]};
+        c.at = {v[3], v[4], v[5]};
+        c.up = {v[6], v[7], v[8]};
+        c.angle = v[9];
+        const Vec3 fwd = c.at - c.from;
+        if (length(fwd) == 0) throw InputError("--camera", 0, "from and at are the same point");
+        if (length(cross(fwd, c.up)) == 0) throw InputError("--camera", 0, "up is parallel to the view direction");
+        if (!(c.angle > 0 && c.angle < 180)) throw InputError("--camera", 0, "the field of view must be in (0, 180) degrees");
+        scene.camera = c;
+        scene.has_camera = true;
+    }
+    if (!view.lights.empty()) {
+        std::vector<Light> lights;
+        for (const std::string& l : view.lights) {
+            const std::vector<float> v = numbers(l, 3, "--light");
+            lights.push_back({{v[0], v[1], v[2]}, {1, 1, 1}});
+        }
+        scene.lights = std::move(lights);
+    }
+}
 
 RaySet make_rays(const Scene& scene, const RaySpec& spec) {
     if (spec.name == "camera") {

@@ -1,6 +1,8 @@
 // The evaluation's JSON document and text tables (what `rtcost eval` prints).
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "rtcost/evaluate.hpp"
 #include "rtcost/report.hpp"
 
@@ -18,6 +20,21 @@ json cost_json(const CostVector& c, double scalar) {
 
 double relative(double predicted, double measured) { return measured > 0 ? (predicted - measured) / measured : 0.0; }
 
+/// The query each ray kind of the test rays is traced with.
+std::string_view query_of(const EvalResult& r, const std::string& kind) {
+    return kind == "shadow" || kind == "ao" ? query_name(r.occlusion) : query_name(r.query);
+}
+
+json queries_json(const EvalResult& r) {
+    json q = json::object();
+    for (const auto& [kind, n] : r.rays_by_kind) q[kind] = query_of(r, kind);
+    return q;
+}
+
+/// Whether the headline prediction is known to be rough: the geometric estimator with early
+/// termination (docs/model-accuracy.md).
+bool rough(const EvalResult& r) { return r.estimators.front() == Estimator::Geometric && r.query != Query::All; }
+
 }  // namespace
 
 nlohmann::json to_json(const EvalResult& r, bool by_depth) {
@@ -27,8 +44,12 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
                   {"build", to_json(row.structure)},
                   {"measured", cost_json(row.measured, row.measured_scalar)},
                   {"mrays_per_s", row.mrays_per_s},
-                  {"rank_measured", row.rank_measured},
-                  {"time", {{"measured_ns_per_ray", row.ns_per_ray}, {"threads", row.threads}}}};
+                  {"rank_measured", row.counted ? json(row.rank_measured) : json(nullptr)},
+                  {"rank_time", row.rank_time},
+                  {"measured_rays", row.measured_rays},
+                  {"time", {{"measured_ns_per_ray", row.ns_per_ray}, {"threads", row.threads},
+                            {"repeats", row.repeats}, {"spread", row.time_spread}}}};
+        if (!row.counted) j["measured"] = nullptr;
         const Prediction* head = row.headline();
         if (r.calibrated && head) j["time"]["predicted_ns_per_ray"] = head->scalar;
         if (head) {
@@ -63,6 +84,7 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
             {"rays", r.test_rays},
             {"distribution", r.distribution},
             {"query", query_name(r.query)},
+            {"queries", queries_json(r)},
             {"estimator", estimator_name(r.estimators.front())},
             {"preset", preset_name(r.presets.front())},
             {"training_rays", r.training_rays},
@@ -73,38 +95,76 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
             {"results", results}};
 }
 
-std::string eval_table(const EvalResult& r, bool by_depth) {
+std::string eval_columns() {
+    return fmt::format("{:<12} {:>9} {:>9} {:>10} {:>11} {:>11} {:>8} {:>10} {:>7} {:>9}\n", "hierarchy", "build s",
+                       "nodes", "bytes", "predicted", "counted", "error", "ns/ray", "spread", "Mrays/s");
+}
+
+std::string eval_row(const EvalRow& row) {
+    const Prediction* head = row.headline();
+    return fmt::format("{:<12} {:>9.4f} {:>9} {:>10} {:>11} {:>11} {:>8} {:>10.1f} {:>7} {:>9.3f}\n", row.name,
+                       row.structure.seconds, row.structure.interior + row.structure.leaves,
+                       human_bytes(row.structure.bytes), head ? fmt::format("{:.2f}", head->scalar) : "-",
+                       row.counted ? fmt::format("{:.2f}", row.measured_scalar) : "-",
+                       head && row.counted ? fmt::format("{:+.1f}%", 100 * row.error) : "-", row.ns_per_ray,
+                       row.repeats > 1 ? fmt::format("{:.0f}%", 100 * row.time_spread) : std::string("-"),
+                       row.mrays_per_s);
+}
+
+std::string eval_header(const EvalResult& r) {
+    std::string kinds;
+    for (const auto& [kind, n] : r.rays_by_kind)
+        kinds += fmt::format("{}{} {} ({})", kinds.empty() ? "" : ", ", kind, query_of(r, kind), n);
+    const Estimator est = r.estimators.front();
+    std::string split = r.split == "none" ? "no rays held out"
+                        : r.split == "sample"
+                            ? fmt::format("a sample of {} rays ({:.2f} s to draw) left out of them", r.sample_rays,
+                                          r.sample_seconds)
+                            : fmt::format("{} training rays ({}) left out of them", r.training_rays, r.split);
+    if (r.split.find(" and ") != std::string::npos)
+        split = fmt::format("a sample of {} rays and {} training rays left out of them", r.sample_rays, r.training_rays);
+    return fmt::format("scene {} ({} primitives), {} test rays ({}); {}\nqueries: {}\nmodel: {} estimator, {} preset, "
+                       "costs in {}{}\n",
+                       r.scene, r.primitives, r.test_rays, r.distribution, split, kinds, estimator_name(est),
+                       preset_name(r.presets.front()), r.calibrated ? "ns (calibrated)" : "operations",
+                       rough(r) ? "; with early termination this estimator is a rough guide (docs/model-accuracy.md)"
+                                : "");
+}
+
+std::string eval_summary(const EvalResult& r, bool by_depth) {
     std::string out;
     auto print = [&out]<class... T>(fmt::format_string<T...> f, T&&... args) {
         out += fmt::format(f, std::forward<T>(args)...);
     };
-    const Estimator est = r.estimators.front();
-    print("scene {} ({} primitives), {} test rays ({}), {} query\n", r.scene, r.primitives, r.test_rays,
-          r.distribution, query_name(r.query));
-    print("model: {} estimator{}, {} preset, costs in {}\n", estimator_name(est),
-          est == Estimator::Sampled    ? fmt::format(" ({} training rays)", r.training_rays)
-          : est == Estimator::Segments ? fmt::format(" ({} sample rays, {:.2f} s to draw)", r.sample_rays, r.sample_seconds)
-                                       : std::string(),
-          preset_name(r.presets.front()), r.calibrated ? "ns" : "operations");
-    print("{:<12} {:>9} {:>9} {:>10} {:>11} {:>11} {:>8} {:>9} {:>5} {:>5}\n", "hierarchy", "build s", "nodes",
-          "bytes", "predicted", "measured", "error", "Mrays/s", "rk-p", "rk-m");
+    // Orders: the cheapest first; rows a column does not rank are left out of it.
+    auto order = [&](int EvalRow::*rank) {
+        std::vector<const EvalRow*> v;
+        for (const EvalRow& row : r.rows)
+            if (row.*rank > 0) v.push_back(&row);
+        std::sort(v.begin(), v.end(), [&](auto* a, auto* b) { return a->*rank < b->*rank; });
+        std::string s;
+        for (const EvalRow* row : v) s += (s.empty() ? "" : " < ") + row->name;
+        return s.empty() ? std::string("-") : s;
+    };
+    print("\nranked, cheapest first:\n  {:<19} {}\n  {:<19} {}\n  {:<19} {}\n",
+          r.calibrated ? "by predicted time" : "by predicted ops", order(&EvalRow::rank_predicted),
+          "by counted ops", order(&EvalRow::rank_measured), "by measured time", order(&EvalRow::rank_time));
     for (const EvalRow& row : r.rows) {
-        const Prediction* head = row.headline();
-        print("{:<12} {:>9.4f} {:>9} {:>10} {:>11} {:>11.2f} {:>8} {:>9.3f} {:>5} {:>5}\n", row.name,
-              row.structure.seconds, row.structure.interior + row.structure.leaves, human_bytes(row.structure.bytes),
-              head ? fmt::format("{:.2f}", head->scalar) : "-", row.measured_scalar,
-              head ? fmt::format("{:+.1f}%", 100 * row.error) : "-", row.mrays_per_s,
-              head ? std::to_string(row.rank_predicted) : "-", row.rank_measured);
+        if (row.measured_rays && row.measured_rays < r.test_rays)
+            print("{} measured on {} of the {} test rays (every {}th), to bound its time\n", row.name, row.measured_rays,
+                  r.test_rays, (r.test_rays + row.measured_rays - 1) / row.measured_rays);
+        if (!row.counted) print("{} is timed only: its operations are not counted and it is not modelled\n", row.name);
     }
     if (!r.rows.empty() && r.rows[0].predictions.size() > 1) {
-        print("\nevery prediction (cost per ray, error):\n{:<12}", "hierarchy");
-        for (const Prediction& p : r.rows[0].predictions) print(" {:>22}", p.estimator + "/" + p.preset);
+        print("\nevery prediction (cost per ray, error; seconds to predict):\n{:<12}", "hierarchy");
+        for (const Prediction& p : r.rows[0].predictions) print(" {:>30}", p.estimator + "/" + p.preset);
         print("\n");
         for (const EvalRow& row : r.rows) {
             if (!row.modelled) continue;
             print("{:<12}", row.name);
             for (const Prediction& p : row.predictions)
-                print(" {:>22}", fmt::format("{:.2f} ({:+.1f}%)", p.scalar, 100 * relative(p.scalar, row.measured_scalar)));
+                print(" {:>30}", fmt::format("{:.2f} ({:+.1f}%; {:.3f} s)", p.scalar,
+                                             100 * relative(p.scalar, row.measured_scalar), p.seconds));
             print("\n");
         }
     }
@@ -119,7 +179,7 @@ std::string eval_table(const EvalResult& r, bool by_depth) {
                   100 * relative(p, row.ns_per_ray));
         }
     }
-    print("\nby kind (predicted / measured per ray):\n");
+    print("\nby kind (predicted / counted per ray):\n");
     for (const EvalRow& row : r.rows) {
         if (!row.modelled) continue;
         const CostVector &p = row.headline()->cost, &m = row.measured;
@@ -129,7 +189,7 @@ std::string eval_table(const EvalResult& r, bool by_depth) {
               m.prim_tests(), p.steps, m.steps);
     }
     if (by_depth) {
-        print("\nvisits per depth (predicted / measured per ray):\n");
+        print("\nvisits per depth (predicted / counted per ray):\n");
         for (const EvalRow& row : r.rows) {
             if (!row.modelled) continue;
             print("{}\n", row.name);
@@ -141,6 +201,12 @@ std::string eval_table(const EvalResult& r, bool by_depth) {
         }
     }
     return out;
+}
+
+std::string eval_table(const EvalResult& r, bool by_depth) {
+    std::string out = eval_header(r) + eval_columns();
+    for (const EvalRow& row : r.rows) out += eval_row(row);
+    return out + eval_summary(r, by_depth);
 }
 
 }  // namespace rtcost

@@ -75,7 +75,23 @@ void Progress::update(std::size_t done) {
     if (now - start_ < std::chrono::seconds(1) || now - last_ < std::chrono::milliseconds(100)) return;
     last_ = now;
     double frac = total_ ? static_cast<double>(done) / total_ : 0;
-    std::fprintf(stderr, "\r%s %5.1f%% (%zu/%zu)", label_.c_str(), 100 * frac, done, total_);
+    const double elapsed = std::chrono::duration<double>(now - start_).count();
+    std::string left = frac > 0 ? fmt::format(", {:.0f} s left", elapsed * (1 - frac) / frac) : std::string();
+    std::fprintf(stderr, "\r\033[K%s %5.1f%% (%zu/%zu)%s", label_.c_str(), 100 * frac, done, total_, left.c_str());
+    std::fflush(stderr);
+    drawn_ = true;
+}
+
+void Progress::restart(std::string label, std::size_t total) {
+    finish();
+    label_ = std::move(label);
+    total_ = total;
+    start_ = last_ = std::chrono::steady_clock::now();
+}
+
+void Progress::note(const std::string& text) {
+    if (!active_) return;
+    std::fprintf(stderr, "\r\033[K%s ...", text.c_str());
     std::fflush(stderr);
     drawn_ = true;
 }

@@ -157,6 +157,12 @@ std::vector<std::string> builtin_scene_names() {
     return names;
 }
 
+std::vector<BuiltinInfo> builtin_scenes() {
+    std::vector<BuiltinInfo> out;
+    for (const Builtin& b : kBuiltins) out.push_back({b.name, b.min_level, b.max_level, b.default_level});
+    return out;
+}
+
 Scene builtin_scene(std::string_view name, int level) {
     for (const Builtin& b : kBuiltins) {
         if (name != b.name) continue;

@@ -101,12 +101,42 @@ void Scene::finalize() {
     Vec3 c = bounds_.center();
     float radius = 0.5f * length(bounds_.extent());
     if (!has_camera) {
-        // Frame the bounding sphere from a three-quarter view, the usual default of mesh viewers.
+        // A three-quarter view, the usual default of mesh viewers, from the side where the
+        // bounding box shows most of itself, moved in until the box's corners just fit the field
+        // of view (framing the bounding sphere instead leaves most pixels empty for a thin
+        // object).
         Camera cam;
         cam.angle = 45;
-        float dist = radius / std::sin(0.5f * cam.angle * std::numbers::pi_v<float> / 180.0f);
+        const double tan_half = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0);
+        const Vec3 e = bounds_.extent();
+        float best_area = -1;
+        Vec3 best_dir{1, 0.6f, 0.8f};
+        for (float sy : {0.6f, 1.6f}) {  // from above too, for a flat object such as a terrain
+            for (int sx : {-1, 1}) {
+                for (int sz : {-1, 1}) {
+                    const Vec3 dir = normalize(Vec3{0.8f * sx, sy, 1.0f * sz});
+                    // Projected area of the box seen along dir: each face's area times |cos|.
+                    const float area =
+                        e.y * e.z * std::fabs(dir.x) + e.x * e.z * std::fabs(dir.y) + e.x * e.y * std::fabs(dir.z);
+                    if (area > best_area + 1e-6f * area) best_area = area, best_dir = dir;
+                }
+            }
+        }
+        const Vec3 fwd = best_dir * -1.0f;
+        const Vec3 right = normalize(cross(fwd, Vec3{0, 1, 0}));
+        const Vec3 up = cross(right, fwd);
+        double dist = 0;
+        for (int k = 0; k < 8; ++k) {
+            const Vec3 p{k & 1 ? bounds_.hi.x : bounds_.lo.x, k & 2 ? bounds_.hi.y : bounds_.lo.y,
+                         k & 4 ? bounds_.hi.z : bounds_.lo.z};
+            const Vec3 q = p - c;
+            const double depth = dot(q, fwd);  // towards the far side: the corner is nearer the eye when < 0
+            const double reach = std::max(std::fabs(dot(q, right)), std::fabs(dot(q, up))) / tan_half;
+            dist = std::max(dist, reach - depth);
+        }
+        dist = std::max(dist * 1.02, 1e-3 * radius);
         cam.at = c;
-        cam.from = c + normalize(Vec3{1, 0.6f, 0.8f}) * (dist * 1.05f);
+        cam.from = c + best_dir * static_cast<float>(dist);
         cam.up = Vec3{0, 1, 0};
         cam.hither = radius * 1e-3f;
         camera = cam;

@@ -15,6 +15,9 @@ namespace {
 
 class EmbreeHierarchy final : public Hierarchy {
 public:
+    /// Embree's internal operations are not visible: it is timed, not counted.
+    bool counted() const override { return false; }
+
     EmbreeHierarchy(const Scene& scene, const Params& p) : Hierarchy(scene) {
         long long threads = p.integer("threads", 0, 1024);
         std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
