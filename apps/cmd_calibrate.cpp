@@ -52,10 +52,10 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
             if (!h->counted()) continue;  // Embree's operations are not counted
             TraceOptions opt;
             opt.threads = 1;  // unit costs are single-thread figures
-            // The fastest of several runs: the least disturbed by the machine (and, for lazily
+            // CPU time, the fastest of several runs: the least disturbed by the machine (and, for lazily
             // built structures, the runs after the build).
             double best = kInf;
-            for (int r = 0; r < a.repeat; ++r) best = std::min(best, trace_ray_set(*h, rays, opt).seconds);
+            for (int r = 0; r < a.repeat; ++r) best = std::min(best, trace_ray_set(*h, rays, opt).cpu_seconds);
             opt.count = true;
             TraceResult counted = trace_ray_set(*h, rays, opt);
             CalibrationSample s;
