@@ -32,7 +32,9 @@ async function main() {
       return route.abort();
     });
     await page.goto(url);
-    await page.waitForFunction(() => document.body.dataset.plots !== undefined, null, { timeout: 60000 });
+    // The page's script marks the body when every plot is done (or one failed).
+    await page.waitForFunction(() => document.body.dataset.plots !== undefined, null, { timeout: 60000 })
+      .catch(() => problems.push('the plots never finished (60 s)'));
     const state = await page.evaluate(() => {
       const plots = [...document.querySelectorAll('div.plot')].map((d) => {
         const svg = d.querySelector('svg');
@@ -41,7 +43,7 @@ async function main() {
                  marks: svg ? svg.querySelectorAll('g.role-mark > path, g.role-mark > text, g.role-mark > line').length : 0 };
       });
       const images = [...document.querySelectorAll('img')].map((i) => ({ alt: i.alt, ok: i.complete && i.naturalWidth > 0 }));
-      return { plots, images, status: document.body.dataset.plots,
+      return { plots, images, status: document.body.dataset.plots || 'not finished',
                rows: document.querySelectorAll('#eval tbody tr').length,
                hierarchies: JSON.parse(document.getElementById('rtcost-plots').textContent)['plot-speed'].data.values.length };
     });
