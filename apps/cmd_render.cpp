@@ -21,6 +21,7 @@ struct RenderArgs {
     std::string rays = "camera";
     std::string costs;
     double scale_max = 0;
+    bool log = false;
 };
 
 int cmd_heatmap(const RenderArgs& a, const Common& common, const Scene& scene, const Hierarchy& h,
@@ -47,6 +48,7 @@ int cmd_heatmap(const RenderArgs& a, const Common& common, const Scene& scene, c
                               opt.tree ? fmt::format("Whitted tree, depth {}", a.depth) : "camera rays", a.heatmap);
     style.units = heat_units(kind, costs);
     style.scale_max = a.scale_max;
+    style.log = a.log;
     const std::string png = encode_png(draw_heatmap(values, pc.width, pc.height, style));
     write_file_atomic(a.out, png);
     const HeatSummary s = summarize(values, a.scale_max);
@@ -77,8 +79,9 @@ int cmd_render(const RenderArgs& a, const Common& common) {
     opt.threads = a.threads;
     auto h = build(scene, a.b, common);
     if (!a.heatmap.empty()) return cmd_heatmap(a, common, scene, *h, opt);
-    if (a.rays != "camera" || !a.costs.empty() || a.scale_max > 0)
-        throw InputError("--heatmap", 0, "--rays, --costs and --scale-max apply to heat maps: give --heatmap KIND");
+    if (a.rays != "camera" || !a.costs.empty() || a.scale_max > 0 || a.log)
+        throw InputError("--heatmap", 0,
+                         "--rays, --costs, --scale-max and --log-scale apply to heat maps: give --heatmap KIND");
     Image img;
     auto start = std::chrono::steady_clock::now();
     {
@@ -122,6 +125,7 @@ Subcommand setup_render(CLI::App& parent, Common& common) {
     cmd->add_option("--scale-max", a->scale_max, "top of the heat map's colour scale (default: the largest value), "
                                                  "to compare hierarchies on one scale")
         ->check(CLI::PositiveNumber);
+    cmd->add_flag("--log-scale", a->log, "heat map colours by log(1 + value), for costs that span decades");
     add_common(cmd, common);
     cmd->footer(hierarchy_help());
     return {cmd, [a, &common] { return cmd_render(*a, common); }};

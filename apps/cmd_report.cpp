@@ -20,6 +20,7 @@ struct ReportArgs {
     std::string heatmap = "ops";
     std::string heatmap_size;
     double scale_max = 0;
+    bool log = false;
     int threads = 0;
     std::string out = "report.html";
 };
@@ -47,6 +48,7 @@ int cmd_report(const ReportArgs& a, const Common& common) {
     heat.tree = a.rays.name == "spd";
     heat.costs = costs;
     heat.scale_max = a.scale_max;
+    heat.log = a.log;
     heat.threads = a.threads;
     if (!a.heatmap_size.empty()) parse_size(a.heatmap_size, "--heatmap-size", heat.width, heat.height);
     else if (!a.rays.size.empty()) parse_size(a.rays.size, "--size", heat.width, heat.height);
@@ -93,6 +95,7 @@ Subcommand setup_report(CLI::App& parent, Common& common) {
     cmd->add_option("--heatmap-size", a->heatmap_size, "heat maps' size WxH (default: --size, else 256x256)");
     cmd->add_option("--scale-max", a->scale_max, "top of the heat maps' colour scale (default: the largest value)")
         ->check(CLI::PositiveNumber);
+    cmd->add_flag("--log-scale", a->log, "heat map colours by log(1 + value), for costs that span decades");
     cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024));
     cmd->add_option("-o,--out", a->out, "HTML file to write")->capture_default_str();
     add_common(cmd, common);

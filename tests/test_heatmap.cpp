@@ -134,6 +134,13 @@ TEST(DrawHeatmap, ViridisEndsClippingAndLegendText) {
     EXPECT_NEAR(mid[0], 33, 1);
     EXPECT_NEAR(mid[1], 145, 1);
     EXPECT_NEAR(mid[2], 140, 1);
+    style.scale_max = 99;  // log scale: 9 is half way, log(10) / log(100)
+    style.log = true;
+    auto logmid = pixel(draw_heatmap({0.0, 9.0}, 2, 1, style), 10 + 96 + 40, 10 + 40);
+    EXPECT_NEAR(logmid[0], 33, 1);
+    EXPECT_NEAR(logmid[1], 145, 1);
+    EXPECT_NEAR(logmid[2], 140, 1);
+    style.log = false;
     style.scale_max = 5;  // above the scale: the top colour, and counted
     Image clipped = draw_heatmap({0.0, 10.0}, 2, 1, style);
     EXPECT_EQ(pixel(clipped, 10 + 96 + 40, 10 + 40), kHigh);

@@ -74,6 +74,9 @@ struct HeatStyle {
     std::string title;       ///< first line of the legend (e.g. "bvh-sah on balls")
     std::string units;       ///< what the colour bar measures
     double scale_max = 0;    ///< top of the colour bar; 0: the largest value
+    /// Colour by log(1 + value) (for maps whose costs span decades, e.g. several hierarchies on
+    /// one scale), else linear.
+    bool log = false;
 };
 
 /// Summary of the values drawn.

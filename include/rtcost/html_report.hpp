@@ -42,6 +42,7 @@ struct ReportHeatOptions {
     bool tree = false;       ///< each pixel's Whitted tree (`--rays spd`), else its camera ray
     UnitCosts costs;         ///< for HeatKind::Ops
     double scale_max = 0;    ///< 0: the largest value over every hierarchy
+    bool log = false;        ///< colours by log(1 + value)
     int threads = 0;
     std::function<void(const std::string& step)> on_step;  ///< "heat map NAME", before each
 };

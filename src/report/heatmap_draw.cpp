@@ -51,8 +51,36 @@ double text_width(cairo_t* cr, const std::string& s) {
     return e.x_advance;
 }
 
+// Where `v` falls on the colour scale, 0 to 1.
+struct Scale {
+    double top;
+    bool log;
+    double operator()(double v) const {
+        if (!(top > 0)) return 0;
+        return log ? std::log1p(std::max(v, 0.0)) / std::log1p(top) : v / top;
+    }
+};
+
+// Tick values: round steps on a linear scale; 0 and 1, 2 and 5 times powers of ten on a log one.
+std::vector<double> ticks_of(const Scale& s) {
+    std::vector<double> t;
+    if (!(s.top > 0)) return {0};
+    if (!s.log) {
+        const double step = nice_step(s.top, 4);
+        for (double v = 0; v <= s.top * (1 + 1e-9); v += step) t.push_back(v);
+        return t;
+    }
+    t.push_back(0);
+    std::vector<double> mult = {1.0};
+    if (s.top < 100) mult = {1.0, 2.0, 5.0};
+    for (double p = 1; p <= s.top * (1 + 1e-9); p *= 10)
+        for (double m : mult)
+            if (m * p <= s.top * (1 + 1e-9)) t.push_back(m * p);
+    return t;
+}
+
 // The values as a cairo image, one pixel each.
-Surface map_surface(const std::vector<double>& values, int width, int height, double top) {
+Surface map_surface(const std::vector<double>& values, int width, int height, const Scale& scale) {
     Surface s(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height));
     cairo_surface_flush(s.get());
     unsigned char* data = cairo_image_surface_get_data(s.get());
@@ -60,7 +88,7 @@ Surface map_surface(const std::vector<double>& values, int width, int height, do
     for (int j = 0; j < height; ++j) {
         auto* row = reinterpret_cast<std::uint32_t*>(data + static_cast<std::size_t>(j) * stride);
         for (int i = 0; i < width; ++i) {
-            auto c = viridis(top > 0 ? values[static_cast<std::size_t>(j) * width + i] / top : 0);
+            auto c = viridis(scale(values[static_cast<std::size_t>(j) * width + i]));
             row[i] = (std::uint32_t{c[0]} << 16) | (std::uint32_t{c[1]} << 8) | c[2];
         }
     }
@@ -79,10 +107,9 @@ Image draw_heatmap(const std::vector<double>& values, int width, int height, con
     const double mw = width * zoom, mh = height * zoom;
 
     // Tick labels and text lines, measured first to size the image.
-    const double step = top > 0 ? nice_step(top, 4) : 1;
-    std::vector<double> ticks;
-    for (double t = 0; t <= top * (1 + 1e-9); t += step) ticks.push_back(t);
-    std::vector<std::string> lines = {style.title, style.units,
+    const Scale scale{top, style.log};
+    const std::vector<double> ticks = ticks_of(scale);
+    std::vector<std::string> lines = {style.title, style.log ? style.units + ", log scale" : style.units,
                                       fmt::format("min {:.4g}  mean {:.4g}  max {:.4g}", sum.min, sum.mean, sum.max)};
     if (sum.clipped)
         lines.push_back(fmt::format("scale top {}: {} pixels above it drawn in its colour", label(top), sum.clipped));
@@ -102,7 +129,7 @@ Image draw_heatmap(const std::vector<double>& values, int width, int height, con
     cairo_paint(cr.get());
 
     // The map, enlarged by whole pixels without smoothing.
-    Surface map = map_surface(values, width, height, top);
+    Surface map = map_surface(values, width, height, scale);
     cairo_save(cr.get());
     cairo_translate(cr.get(), kMargin, kMargin);
     cairo_scale(cr.get(), zoom, zoom);
@@ -124,7 +151,7 @@ Image draw_heatmap(const std::vector<double>& values, int width, int height, con
     cairo_stroke(cr.get());
     set_font(cr.get(), kFont);
     for (double t : ticks) {
-        double y = kMargin + mh * (1 - (top > 0 ? t / top : 0));
+        double y = kMargin + mh * (1 - scale(t));
         cairo_move_to(cr.get(), bar_x + kBarWidth, std::round(y) + 0.5);
         cairo_line_to(cr.get(), bar_x + kBarWidth + 4, std::round(y) + 0.5);
         cairo_stroke(cr.get());

@@ -207,9 +207,10 @@ std::string report_html(const ReportInput& in) {
 
     h += "<h2>Scene and per-pixel cost</h2>\n";
     if (!in.heatmaps.empty())
-        h += fmt::format("<p class=\"lead\">Heat maps: {} of {}, {}x{} pixels, on one scale (0 to {:.6g}).</p>\n",
+        h += fmt::format("<p class=\"lead\">Heat maps: {} of {}, {}x{} pixels, on one {}scale (0 to {:.6g}).</p>\n",
                          esc(in.heat.value("units", "")), esc(in.heat.value("rays", "")), in.heat.value("width", 0),
-                         in.heat.value("height", 0), in.heat.value("scale_max", 0.0));
+                         in.heat.value("height", 0), in.heat.value("log", false) ? "logarithmic " : "",
+                         in.heat.value("scale_max", 0.0));
     h += "<div class=\"images\">\n";
     if (!in.render.png.empty()) h += figure(in.render, "render", true);
     for (const ReportImage& img : in.heatmaps) h += figure(img, "heatmap", false);

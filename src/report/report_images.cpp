@@ -61,11 +61,12 @@ void add_heatmaps(ReportInput& in, const Scene& scene, const std::vector<std::st
         style.title = fmt::format("{}: {}", m.label, heat_kind_name(opt.kind));
         style.units = units;
         style.scale_max = top;
+        style.log = opt.log;
         in.heatmaps.push_back({style.title, encode_png(draw_heatmap(m.values, opt.width, opt.height, style))});
         list.push_back({{"hierarchy", m.label}, {"min", m.summary.min}, {"mean", m.summary.mean}, {"max", m.summary.max}});
     }
     in.heat = {{"kind", heat_kind_name(opt.kind)}, {"units", units}, {"rays", rays}, {"width", opt.width},
-               {"height", opt.height}, {"scale_max", top}, {"maps", list}};
+               {"height", opt.height}, {"scale_max", top}, {"log", opt.log}, {"maps", list}};
 }
 
 void add_render(ReportInput& in, const Scene& scene, int width, int height, int threads) {
