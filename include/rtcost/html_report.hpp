@@ -54,7 +54,8 @@ struct ReportHeatOptions {
 void add_heatmaps(ReportInput& in, const Scene& scene, const std::vector<std::string>& labels,
                   const ReportHeatOptions& opt);
 
-/// Adds the scene shaded (`render`, through bvh-sah) at width x height.
+/// Adds the scene shaded (`render`, through bvh-sah) at width x height, enlarged by a whole
+/// factor to at least 256 pixels on its longer side.
 void add_render(ReportInput& in, const Scene& scene, int width, int height, int threads = 0);
 
 /// The machine (CPU model, cores, OS), the date (UTC, ISO 8601), the command line of this

@@ -71,6 +71,10 @@ void add_heatmaps(ReportInput& in, const Scene& scene, const std::vector<std::st
 
 void add_render(ReportInput& in, const Scene& scene, int width, int height, int threads) {
     auto h = build_hierarchy(scene, "bvh-sah");
+    // Shown beside heat maps that are enlarged to at least 192 pixels: no smaller than 256.
+    const int zoom = std::max(1, (256 + std::max(width, height) - 1) / std::max(width, height));
+    width *= zoom;
+    height *= zoom;
     RenderOptions opt;
     opt.width = width;
     opt.height = height;

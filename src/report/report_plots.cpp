@@ -76,8 +76,11 @@ json scatter(const json& results, const std::string& units) {
                   {"encoding",
                    {{"x", {{"field", "v"}, {"type", "quantitative"}, {"scale", scale}, {"title", "measured"}}},
                     {"y", {{"field", "v"}, {"type", "quantitative"}, {"scale", scale}, {"title", "predicted"}}}}}};
-    json enc = {{"x", {{"field", "measured"}, {"type", "quantitative"}, {"scale", scale}}},
-                {"y", {{"field", "predicted"}, {"type", "quantitative"}, {"scale", scale}}},
+    ideal["encoding"]["x"]["axis"] = {{"labelOverlap", "greedy"}, {"tickCount", 6}};
+    ideal["encoding"]["y"]["axis"] = {{"labelOverlap", "greedy"}, {"tickCount", 6}};
+    const json axis = {{"labelOverlap", "greedy"}, {"tickCount", 6}};
+    json enc = {{"x", {{"field", "measured"}, {"type", "quantitative"}, {"scale", scale}, {"axis", axis}}},
+                {"y", {{"field", "predicted"}, {"type", "quantitative"}, {"scale", scale}, {"axis", axis}}},
                 {"tooltip", json::array({{{"field", "hierarchy"}},
                                          {{"field", "predicted"}, {"format", ".3f"}},
                                          {{"field", "measured"}, {"format", ".3f"}},
