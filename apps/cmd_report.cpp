@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli.hpp"
+#include "rtcost/evaluate.hpp"
 #include "rtcost/html_report.hpp"
 
 namespace rtcost::cli {
@@ -26,8 +27,20 @@ struct ReportArgs {
 };
 
 json run_eval(const ReportArgs& a, const Scene& scene, const UnitCosts& costs, const Common& common) {
-    (void)a, (void)scene, (void)costs, (void)common;
-    throw InputError("report", 0, "the evaluation library call is not merged yet: give --from-eval FILE");
+    EvalOptions opt;
+    opt.hierarchies = parse_hierarchy_list(a.hierarchies, scene.size());
+    opt.estimators = {a.estimator == "geometric" ? Estimator::Geometric
+                      : a.estimator == "segments" ? Estimator::Segments
+                                                  : Estimator::Sampled};
+    opt.costs = costs;
+    opt.threads = a.threads;
+    opt.sample_seed = a.rays.seed;
+    Progress progress("report: eval", opt.hierarchies.size(), common.quiet || common.json);
+    std::size_t done = 0;
+    opt.on_row = [&](const EvalRow&) { progress.update(++done); };
+    const EvalResult r = evaluate(scene, a.rays, opt);
+    progress.finish();
+    return to_json(r, true);
 }
 
 json read_eval(const std::string& path) {
@@ -59,7 +72,7 @@ int cmd_report(const ReportArgs& a, const Common& common) {
     std::vector<std::string> labels;
     for (const json& r : in.eval["results"]) labels.push_back(r.value("hierarchy", ""));
     {
-        Progress progress("report heat maps", labels.size(), common.quiet || common.json);
+        Progress progress("report: heat maps", labels.size(), common.quiet || common.json);
         std::size_t done = 0;
         heat.on_step = [&](const std::string&) { progress.update(done++); };
         add_heatmaps(in, scene, labels, heat);
@@ -84,8 +97,8 @@ Subcommand setup_report(CLI::App& parent, Common& common) {
     cmd->add_option("SCENE", a->scene, "scene file or builtin:NAME[:level]")->required();
     cmd->add_option("-H,--hierarchy", a->hierarchies, "comma-separated hierarchies, or all")->capture_default_str();
     add_ray_args(cmd, a->rays);
-    cmd->add_option("--estimator", a->estimator, "geometric or sampled")
-        ->check(CLI::IsMember({"geometric", "sampled"}))
+    cmd->add_option("--estimator", a->estimator, "the model's estimator: geometric, sampled or segments")
+        ->check(CLI::IsMember({"geometric", "sampled", "segments"}))
         ->capture_default_str();
     cmd->add_option("--costs", a->costs, "unit costs file (from rtcost calibrate)");
     cmd->add_option("--from-eval", a->from_eval, "take the evaluation from this `rtcost eval --json --by-depth` file "

@@ -12,7 +12,7 @@ command -v node > /dev/null || skip "no node on PATH"
 [ -d "$src/third_party/js/node_modules/playwright-core" ] || skip "no third_party/js/node_modules/playwright-core"
 mkdir -p "$out"
 SECONDS=0
-"$rtcost" report builtin:balls:3 --from-eval "$src/tests/data/eval_balls3.json" --heatmap-size 96x96 -q \
+"$rtcost" report builtin:balls:3 -H bvh-sah,kd-sah,grid,octree,rc5d --size 64x64 --heatmap-size 96x96 -q \
   -o "$out/report.html"
 node "$src/tests/browser/report_page.cjs" "$out/report.html" "$out/report.png" "$chromium"
 echo "ReportInBrowser: ${SECONDS} s in all"
