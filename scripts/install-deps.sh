@@ -11,7 +11,12 @@ packages=(
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libpng-dev libstb-dev              # images
   libgtest-dev libgmock-dev libbenchmark-dev
+  libcairo2-dev fonts-dejavu-core    # heat maps: legends drawn with a real font
+  chromium                           # the report's test in a headless browser
 )
+# npm installs the report's plotting library (Vega-Lite) and the browser test's driver; a machine
+# with Node.js from elsewhere (e.g. NodeSource) keeps it.
+command -v npm > /dev/null || packages+=(nodejs npm)
 
 missing=()
 for p in "${packages[@]}"; do
@@ -19,11 +24,23 @@ for p in "${packages[@]}"; do
 done
 if [ ${#missing[@]} -eq 0 ]; then
   echo "install-deps: all ${#packages[@]} packages already installed"
-  exit 0
+else
+  sudo=""
+  [ "$(id -u)" -eq 0 ] || sudo="sudo"
+  echo "install-deps: installing ${missing[*]}"
+  $sudo apt-get update -q
+  DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
 fi
 
-sudo=""
-[ "$(id -u)" -eq 0 ] || sudo="sudo"
-echo "install-deps: installing ${missing[*]}"
-$sudo apt-get update -q
-DEBIAN_FRONTEND=noninteractive $sudo apt-get install -y -q --no-install-recommends "${missing[@]}"
+# Vega, Vega-Lite, vega-embed (inlined into `rtcost report` pages by the build) and
+# playwright-core, at the versions third_party/js/package-lock.json pins, into
+# third_party/js/node_modules (ignored by git); skipped when that install is of the current lock.
+js="$(cd "$(dirname "$0")/.." && pwd)/third_party/js"
+lock_sum="$(sha256sum "$js/package-lock.json" | cut -d' ' -f1)"
+if [ "$(cat "$js/node_modules/.rtcost-lock" 2>/dev/null)" != "$lock_sum" ]; then
+  echo "install-deps: npm ci in third_party/js"
+  (cd "$js" && npm ci --no-audit --no-fund --loglevel=error)
+  echo "$lock_sum" > "$js/node_modules/.rtcost-lock"
+else
+  echo "install-deps: third_party/js/node_modules is current"
+fi

@@ -1,0 +1,122 @@
+// `rtcost report`: the evaluation, the scene's render and every hierarchy's heat map as one
+// self-contained HTML page (and, with --json, the data behind it).
+#include <fstream>
+#include <iostream>
+
+#include "cli.hpp"
+#include "rtcost/evaluate.hpp"
+#include "rtcost/html_report.hpp"
+
+namespace rtcost::cli {
+namespace {
+using nlohmann::json;
+
+struct ReportArgs {
+    std::string scene;
+    std::string hierarchies = "all";
+    RaySpec rays;
+    std::string estimator = "sampled";
+    std::string costs;
+    std::string from_eval;
+    std::string heatmap = "ops";
+    std::string heatmap_size;
+    double scale_max = 0;
+    bool log = false;
+    int threads = 0;
+    std::string out = "report.html";
+};
+
+json run_eval(const ReportArgs& a, const Scene& scene, const UnitCosts& costs, const Common& common) {
+    EvalOptions opt;
+    opt.hierarchies = parse_hierarchy_list(a.hierarchies, scene.size());
+    opt.estimators = {a.estimator == "geometric" ? Estimator::Geometric
+                      : a.estimator == "segments" ? Estimator::Segments
+                                                  : Estimator::Sampled};
+    opt.costs = costs;
+    opt.threads = a.threads;
+    opt.sample_seed = a.rays.seed;
+    Progress progress("report: eval", opt.hierarchies.size(), common.quiet || common.json);
+    std::size_t done = 0;
+    opt.on_row = [&](const EvalRow&) { progress.update(++done); };
+    const EvalResult r = evaluate(scene, a.rays, opt);
+    progress.finish();
+    return to_json(r, true);
+}
+
+json read_eval(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, 0, "no such file");
+    json j = json::parse(in, nullptr, false);
+    if (j.is_discarded() || !j.is_object() || !j.contains("results") || !j["results"].is_array())
+        throw InputError(path, 0, "not an `rtcost eval --json` document");
+    return j;
+}
+
+int cmd_report(const ReportArgs& a, const Common& common) {
+    Scene scene = load(a.scene, common);
+    const UnitCosts costs = a.costs.empty() ? UnitCosts{} : UnitCosts::read(a.costs);
+    const HeatKind kind = parse_heat_kind(a.heatmap);
+    ReportHeatOptions heat;
+    heat.kind = kind;
+    heat.tree = a.rays.name == "spd";
+    heat.costs = costs;
+    heat.scale_max = a.scale_max;
+    heat.log = a.log;
+    heat.threads = a.threads;
+    if (!a.heatmap_size.empty()) parse_size(a.heatmap_size, "--heatmap-size", heat.width, heat.height);
+    else if (!a.rays.size.empty()) parse_size(a.rays.size, "--size", heat.width, heat.height);
+
+    ReportInput in;
+    in.meta = report_meta();
+    in.eval = a.from_eval.empty() ? run_eval(a, scene, costs, common) : read_eval(a.from_eval);
+    std::vector<std::string> labels;
+    for (const json& r : in.eval["results"]) labels.push_back(r.value("hierarchy", ""));
+    {
+        Progress progress("report: heat maps", labels.size(), common.quiet || common.json);
+        std::size_t done = 0;
+        heat.on_step = [&](const std::string&) { progress.update(done++); };
+        add_heatmaps(in, scene, labels, heat);
+    }
+    add_render(in, scene, heat.width, heat.height, a.threads);
+    const std::string html = report_html(in);
+    write_file_atomic(a.out, html);
+    if (common.json) {
+        std::cout << report_json(in).dump(2) << "\n";
+        return 0;
+    }
+    fmt::print("report     {}: {} hierarchies, {} heat maps ({}), {}\n", scene.name, labels.size(), in.heatmaps.size(),
+               a.heatmap, in.eval.value("distribution", "?"));
+    fmt::print("written    {} ({})\n", a.out, human_bytes(html.size()));
+    return 0;
+}
+
+Subcommand setup_report(CLI::App& parent, Common& common) {
+    auto a = std::make_shared<ReportArgs>();
+    auto* cmd = parent.add_subcommand("report", "evaluate hierarchies and write one self-contained HTML page: the "
+                                                "table, plots of predicted against measured cost, heat maps");
+    cmd->add_option("SCENE", a->scene, "scene file or builtin:NAME[:level]")->required();
+    cmd->add_option("-H,--hierarchy", a->hierarchies, "comma-separated hierarchies, or all")->capture_default_str();
+    add_ray_args(cmd, a->rays);
+    cmd->add_option("--estimator", a->estimator, "the model's estimator: geometric, sampled or segments")
+        ->check(CLI::IsMember({"geometric", "sampled", "segments"}))
+        ->capture_default_str();
+    cmd->add_option("--costs", a->costs, "unit costs file (from rtcost calibrate)");
+    cmd->add_option("--from-eval", a->from_eval, "take the evaluation from this `rtcost eval --json --by-depth` file "
+                                                 "instead of running it");
+    cmd->add_option("--heatmap", a->heatmap, "what the heat maps show: box, plane, hop, classify, prim, steps, ops, time")
+        ->capture_default_str();
+    cmd->add_option("--heatmap-size", a->heatmap_size, "heat maps' size WxH (default: --size, else 256x256)");
+    cmd->add_option("--scale-max", a->scale_max, "top of the heat maps' colour scale (default: the largest value)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_flag("--log-scale", a->log, "heat map colours by log(1 + value), for costs that span decades");
+    cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024));
+    cmd->add_option("-o,--out", a->out, "HTML file to write")->capture_default_str();
+    add_common(cmd, common);
+    cmd->footer(hierarchy_help());
+    return {cmd, [a, &common] { return cmd_report(*a, common); }};
+}
+
+const CommandRegistration reg{65, setup_report};
+
+}  // namespace
+}  // namespace rtcost::cli
