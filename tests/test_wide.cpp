@@ -19,7 +19,7 @@ TEST(BvhWide, NodesHoldAtMostWidthChildrenAndEveryPrimitiveOnce) {
         for (const ModelNode& n : t.nodes) {
             if (n.leaf) {
                 EXPECT_GE(n.count, 1u);
-                EXPECT_LE(n.count, 4u);  // max_prims=4
+                EXPECT_LE(n.count, 16u);  // max_prims=16
                 continue;
             }
             EXPECT_GE(n.count, 1u);

@@ -58,8 +58,7 @@ BvhData build_sah(const Scene& s, const SahOptions& o);
 /// stored order, and no subtree is cut by a hit found (the paper's BVH case).
 class Bvh final : public HierarchyImpl<Bvh> {
 public:
-    Bvh(const Scene& s, std::string name, BvhData data, bool ordered)
-        : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered) {}
+    Bvh(const Scene& s, std::string name, BvhData data, bool ordered);
 
     std::string_view name() const override { return name_; }
     bool emit_model(ModelSink& sink) const override;
@@ -103,8 +102,23 @@ private:
                 const Node& n = nodes[e.node];
                 if (n.leaf) {
                     counting.leaf(e.depth, n.count);
-                    for (std::uint32_t k = 0; k < n.count; ++k) {
-                        if (test_prim(*scene_, d_.refs[n.index + k], ray, hit, counting)) {
+                    for (const LeafPrim* p = &prims_[n.index]; p != &prims_[n.index] + n.count; ++p) {
+                        bool met;
+                        if (p->as_triangle) {
+                            // test_prim's steps on the leaf-order copy of the same triangle.
+                            counting.prim(p->kind);
+                            Ray r = ray;
+                            r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
+                            float t;
+                            met = intersect(p->tri, r, t);
+                            if (met) {
+                                hit.t = t;
+                                hit.prim = static_cast<std::int32_t>(p->id);
+                            }
+                        } else {
+                            met = test_prim(*scene_, p->id, ray, hit, counting);
+                        }
+                        if (met) {
                             found = true;
                             if constexpr (Q == Query::Any) return true;
                         }
@@ -125,7 +139,10 @@ private:
                         if (tb < ta) std::swap(a, b);
                     }
                     if (a.t != kInf) {
-                        if (b.t != kInf) stack[sp++] = b;
+                        if (b.t != kInf) {
+                            stack[sp++] = b;
+                            prefetch(nodes[b.node]);
+                        }
                         e = a;
                         continue;
                     }
@@ -162,9 +179,26 @@ private:
         return found;
     }
 
+    /// Incoherent rays wait on memory: what a visit of `n` reads first, fetched ahead.
+    void prefetch(const Node& n) const {
+        if (n.leaf) __builtin_prefetch(prims_.data() + n.index);
+        else __builtin_prefetch(d_.nodes.data() + n.index);
+    }
+
+    /// A leaf reference as its test needs it, in leaf order (BvhData::refs): the id, the kind
+    /// counted and, for a triangle or a three-vertex polygon (which Scene::intersect tests as
+    /// that same triangle), its vertices, so that a leaf's triangles are read contiguously.
+    struct LeafPrim {
+        Triangle tri;
+        std::uint32_t id = 0;
+        PrimKind kind = PrimKind::Triangle;
+        bool as_triangle = false;
+    };
+
     std::string name_;
     BvhData d_;
     bool ordered_;
+    std::vector<LeafPrim> prims_;
 };
 
 }  // namespace rtcost::bvh
