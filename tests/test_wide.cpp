@@ -36,11 +36,17 @@ TEST(BvhWide, NodesHoldAtMostWidthChildrenAndEveryPrimitiveOnce) {
         const StructureStats st = h->structure();
         EXPECT_EQ(st.references, s.size());
         EXPECT_GE(st.leaves, st.interior + 1);
-        // Collapsing fills the nodes: a mean fan-out well above binary, and a shallower tree.
-        const double fanout = static_cast<double>(st.interior - 1 + st.leaves) / static_cast<double>(st.interior);
-        EXPECT_GT(fanout, w == 8 ? 4.0 : 3.0);
-        const StructureStats bin = build_hierarchy(s, "bvh-sah", {"max_prims=4"})->structure();
-        EXPECT_LT(st.depth, bin.depth);
+        // Collapsing fills the nodes: over the same small-leaf SAH tree, a mean fan-out well
+        // above binary (measured: 3.18 four-wide, 4.09 eight-wide) and half the depth or less.
+        Scene big = builtin_scene("balls", 3);
+        std::vector<std::string> small_leaves = set;
+        small_leaves.insert(small_leaves.end(), {"max_prims=2", "c_trav=1"});
+        const StructureStats wide = build_hierarchy(big, "bvh-wide", small_leaves)->structure();
+        const double fanout = static_cast<double>(wide.interior - 1 + wide.leaves) / static_cast<double>(wide.interior);
+        EXPECT_GT(fanout, w == 8 ? 3.6 : 3.0);
+        const StructureStats bin = build_hierarchy(big, "bvh-sah", {"max_prims=2"})->structure();
+        EXPECT_EQ(wide.leaves, bin.leaves);  // the same leaves, regrouped
+        EXPECT_LE(2 * wide.depth, bin.depth);
     }
 }
 
@@ -110,12 +116,10 @@ TEST(BvhWide, ModelIsExactOnLinesForBothWidths) {
 
 class WideSpd : public ::testing::TestWithParam<std::string> {};
 
-TEST_P(WideSpd, MatchesBruteForceExactlyAndTheModelIsExactOnLines) {
+// Exact hits against brute force on these scenes: bvh-wide's variants in test_hierarchies.cpp.
+TEST_P(WideSpd, TheModelIsExactOnLines) {
     RTCOST_REQUIRE_SPD(GetParam());
     Scene s = load_scene(spd_path(GetParam()));
-    auto rays = hard_rays(s, 50000, 9);
-    expect_variants_match_brute(s, rays, GetParam(),
-                                {{"bvh-wide", {}}, {"bvh-wide", {"width=4"}}, {"bvh-wide", {"simd=baseline"}}});
     expect_model_exact(s, "bvh-wide", {}, 100000, 4);
     expect_model_exact(s, "bvh-wide", {"width=4"}, 100000, 4);
 }
