@@ -33,7 +33,8 @@ def main():
                 one[(scene, dist)][h] = (b["Mrays/s"], b.get("bytes", 0), b.get("hit_pct", 0))
             else:
                 per_iter = b["wall_Mrays"] / b["iterations"]
-                many[(scene, dist)][h] = per_iter / (b["real_time"] / 1e3)
+                # Mrays per second of wall time, and per second of the process's CPU time
+                many[(scene, dist)][h] = (per_iter / (b["real_time"] / 1e3), per_iter / (b["cpu_time"] / 1e3))
         elif parts[0] == "build":
             build[parts[1]][parts[2]] = (b["real_time"], b["cpu_time"])
         elif parts[0] == "model":
@@ -57,7 +58,8 @@ def main():
             cells.append(f"{mr:.2f} ({mr / ref:.2f}x)" if ref else f"{mr:.2f}")
         print(f"| {k[0]} | {LABEL.get(k[1], k[1])} | {hit:.0f}% | " + " | ".join(cells) + " |")
     if many:
-        print("\n### Traversal, all cores (Mrays/s of wall time; x its own one-thread rate in brackets)\n")
+        print("\n### Traversal, all cores (Mrays/s of wall time, x its own one-thread rate; then Mrays per CPU-second of "
+              "all threads, x the one-thread rate)\n")
         print("| scene | rays | " + " | ".join(hier) + " |")
         print("|---|---|" + "---|" * len(hier))
         for k in sorted(many, key=lambda k: (k[0], KINDS.index(k[1]) if k[1] in KINDS else 99)):
@@ -65,7 +67,10 @@ def main():
             for h in hier:
                 mt = many[k].get(h)
                 st = one.get(k, {}).get(h, (0,))[0]
-                cells.append("-" if mt is None else (f"{mt:.2f} ({mt / st:.2f}x)" if st else f"{mt:.2f}"))
+                if mt is None or not st:
+                    cells.append("-")
+                else:
+                    cells.append(f"{mt[0]:.2f} ({mt[0] / st:.2f}x); {mt[1]:.2f} ({mt[1] / st:.2f}x)")
             print(f"| {k[0]} | {LABEL.get(k[1], k[1])} | " + " | ".join(cells) + " |")
     print("\n### Memory of the structure (MiB)\n")
     print("| scene | " + " | ".join(hier) + " |")
@@ -73,13 +78,16 @@ def main():
     for scene in sorted({k[0] for k in keys}):
         k = next(k for k in keys if k[0] == scene)
         print(f"| {scene} | " + " | ".join(f"{one[k][h][1] / 2**20:.1f}" if h in one[k] else "-" for h in hier) + " |")
-    print("\n### Build, one thread (ms of wall time, CPU time in brackets; x Embree's wall time)\n")
-    print("| scene | hierarchy | ms | x Embree |")
-    print("|---|---|---|---|")
+    print("\n### Build, one thread (ms of wall time and of CPU time, each as a ratio to Embree's)\n")
+    print("| scene | hierarchy | wall ms | x Embree | CPU ms | x Embree |")
+    print("|---|---|---|---|---|---|")
     for scene, hs in build.items():
-        ref = hs.get("embree", (0, 0))[0]
+        ref = hs.get("embree", (0, 0))
         for h, (ms, cpu) in hs.items():
-            print(f"| {scene} | {h} | {ms:.1f} ({cpu:.1f}) | {ms / ref:.2f} |" if ref else f"| {scene} | {h} | {ms:.1f} | - |")
+            if ref[0]:
+                print(f"| {scene} | {h} | {ms:.1f} | {ms / ref[0]:.2f} | {cpu:.1f} | {cpu / ref[1]:.2f} |")
+            else:
+                print(f"| {scene} | {h} | {ms:.1f} | - | {cpu:.1f} | - |")
     if model:
         print("\n### Geometric estimator against tracing the `spd` rays (one thread, same run)\n")
         print("| scene | hierarchy | estimate, ms | spd trace, ms | share | under 5% |")
