@@ -90,6 +90,45 @@ TEST(BvhWide, ARayMissingTheRootPaysOneBoxTestAndNoStep) {
     EXPECT_GT(d.steps, d.leaves);
 }
 
+TEST(BvhWide, TheSampledEstimatorReproducesTheTrainingRaysCounts) {
+    // As ModelSampled does for the other hierarchies: on its own training rays the sampled
+    // estimator's walk is the traversal's (nearest first, ties as the traversal breaks them).
+    // balls: spheres and a ground polygon (scalar leaves); tetra: triangles (packed leaves).
+    for (const char* name : {"balls", "tetra"}) {
+        Scene s = builtin_scene(name, name[0] == 'b' ? 2 : 4);
+        std::vector<Ray> rays = camera_rays(s.camera, 48, 48);
+        std::vector<Ray> more = random_rays(s.bounds(), 3000, 21);
+        rays.insert(rays.end(), more.begin(), more.end());
+        for (const auto& set : std::vector<std::vector<std::string>>{
+                 {"width=4"}, {"width=8"}, {"width=8", "max_prims=1", "c_trav=1"}, {"width=4", "simd=baseline"}}) {
+            auto h = build_hierarchy(s, "bvh-wide", set);
+            const ModelTree t = h->model_tree();
+            for (Query q : {Query::Closest, Query::Any, Query::All}) {
+                RayCounters total;
+                for (const Ray& r : rays) {
+                    Hit hit;
+                    if (q == Query::Closest)
+                        h->closest(r, hit, total);
+                    else if (q == Query::Any)
+                        h->any(r, hit, total);
+                    else
+                        h->all(r, hit, total);
+                }
+                const CostVector m = measured_cost(total);
+                ModelOptions o;
+                o.query = q;
+                const Prediction p = predict_sampled(t, s, rays, o);
+                const std::string what = std::string(name) + " " + ::testing::PrintToString(set) + " query " +
+                                         std::to_string(static_cast<int>(q));
+                EXPECT_NEAR(p.cost.box, m.box, 1e-3 * m.box + 1e-9) << what;
+                EXPECT_NEAR(p.cost.prim_tests(), m.prim_tests(), 1e-3 * m.prim_tests() + 1e-9) << what;
+                EXPECT_NEAR(p.cost.steps, m.steps, 1e-3 * m.steps + 1e-9) << what;
+                EXPECT_NEAR(p.cost.leaves, m.leaves, 1e-3 * m.leaves + 1e-9) << what;
+            }
+        }
+    }
+}
+
 TEST(BvhWide, RejectsAnUnknownWidth) {
     Scene s = builtin_scene("tetra", 2);
     EXPECT_THROW(build_hierarchy(s, "bvh-wide", {"width=5"}), InputError);
