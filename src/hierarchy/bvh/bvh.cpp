@@ -13,22 +13,7 @@ PrimInfo::PrimInfo(const Scene& s) : bounds(s.size()), centroids(s.size()) {
 }
 
 Bvh::Bvh(const Scene& s, std::string name, BvhData data, bool ordered)
-    : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered), prims_(d_.refs.size()) {
-    for (std::size_t k = 0; k < d_.refs.size(); ++k) {
-        LeafPrim& p = prims_[k];
-        const PrimRef& r = s.prims[d_.refs[k]];
-        p.id = d_.refs[k];
-        p.kind = r.kind;
-        if (r.kind == PrimKind::Triangle) {
-            p.tri = s.triangles[r.index];
-            p.as_triangle = true;
-        } else if (r.kind == PrimKind::Polygon && s.polygons[r.index].count == 3) {
-            const Vec3* v = s.polygon_vertices.data() + s.polygons[r.index].first;
-            p.tri = Triangle{v[0], v[1], v[2]};
-            p.as_triangle = true;
-        }
-    }
-}
+    : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered), prims_(leaf_prims(s, d_.refs)) {}
 
 StructureStats Bvh::compute_structure() const {
     StructureStats s = tree_structure(

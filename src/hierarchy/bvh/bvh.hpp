@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rtcost/hierarchy.hpp"
+#include "../common/leaf_prims.hpp"
 
 namespace rtcost::bvh {
 
@@ -103,22 +104,7 @@ private:
                 if (n.leaf) {
                     counting.leaf(e.depth, n.count);
                     for (const LeafPrim* p = &prims_[n.index]; p != &prims_[n.index] + n.count; ++p) {
-                        bool met;
-                        if (p->as_triangle) {
-                            // test_prim's steps on the leaf-order copy of the same triangle.
-                            counting.prim(p->kind);
-                            Ray r = ray;
-                            r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
-                            float t;
-                            met = intersect(p->tri, r, t);
-                            if (met) {
-                                hit.t = t;
-                                hit.prim = static_cast<std::int32_t>(p->id);
-                            }
-                        } else {
-                            met = test_prim(*scene_, p->id, ray, hit, counting);
-                        }
-                        if (met) {
+                        if (test_prim(*scene_, *p, ray, hit, counting)) {
                             found = true;
                             if constexpr (Q == Query::Any) return true;
                         }
@@ -185,20 +171,10 @@ private:
         else __builtin_prefetch(d_.nodes.data() + n.index);
     }
 
-    /// A leaf reference as its test needs it, in leaf order (BvhData::refs): the id, the kind
-    /// counted and, for a triangle or a three-vertex polygon (which Scene::intersect tests as
-    /// that same triangle), its vertices, so that a leaf's triangles are read contiguously.
-    struct LeafPrim {
-        Triangle tri;
-        std::uint32_t id = 0;
-        PrimKind kind = PrimKind::Triangle;
-        bool as_triangle = false;
-    };
-
     std::string name_;
     BvhData d_;
     bool ordered_;
-    std::vector<LeafPrim> prims_;
+    std::vector<LeafPrim> prims_;  ///< BvhData::refs as their tests need them, in leaf order
 };
 
 }  // namespace rtcost::bvh
