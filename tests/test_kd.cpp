@@ -39,8 +39,7 @@ TEST(KdStructure, MedianCutOnFourTrianglesInARow) {
     EXPECT_EQ(st.empty_leaves, 0u);
     EXPECT_EQ(st.references, 4u);
     EXPECT_EQ(st.depth, 2);
-    // Nodes, references (ids and their leaf-order copies for the tests) and boxes.
-    EXPECT_EQ(st.bytes, 7 * sizeof(kd::Node) + 4 * (sizeof(std::uint32_t) + sizeof(LeafPrim)) + 7 * sizeof(Box3));
+    EXPECT_EQ(st.bytes, 7 * sizeof(kd::Node) + 4 * sizeof(std::uint32_t) + 7 * sizeof(Box3));
     ModelTree t = h->model_tree();
     ASSERT_EQ(t.nodes.size(), 7u);
     EXPECT_EQ(t.family, "kd");
@@ -129,7 +128,7 @@ TEST(KdStructure, SahCutsOffTheFarTriangle) {
     EXPECT_EQ(st.empty_leaves, 0u);
     EXPECT_EQ(st.references, 3u);
     EXPECT_EQ(st.depth, 1);
-    EXPECT_EQ(st.bytes, 3 * sizeof(kd::Node) + 3 * (sizeof(std::uint32_t) + sizeof(LeafPrim)));
+    EXPECT_EQ(st.bytes, 3 * sizeof(kd::Node) + 3 * sizeof(std::uint32_t));
     ModelTree t = h->model_tree();
     EXPECT_EQ(t.nodes[0].axis, 0);
     EXPECT_EQ(t.nodes[0].split, std::nextafter(99.0f, 0.0f));

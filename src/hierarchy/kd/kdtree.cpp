@@ -107,8 +107,7 @@ KdData build_tree(const Scene& s, const BuildOptions& o, const Chooser& choose) 
 
 StructureStats KdTree::compute_structure() const {
     StructureStats s = tree_structure(d_.nodes, [](const Node& n) { return n.leaf(); }, [](const Node&) { return 2u; });
-    s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + d_.boxes.size() * sizeof(Box3) +
-              prims_.size() * sizeof(LeafPrim);
+    s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + d_.boxes.size() * sizeof(Box3);
     return s;
 }
 

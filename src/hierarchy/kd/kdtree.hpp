@@ -36,7 +36,6 @@
 #include <utility>
 #include <vector>
 
-#include "../common/leaf_prims.hpp"
 #include "../common/spatial.hpp"
 #include "rtcost/hierarchy.hpp"
 
@@ -126,7 +125,7 @@ class KdTree final : public HierarchyImpl<KdTree> {
 public:
     KdTree(const Scene& s, std::string name, KdData data, bool mailbox)
         : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), boxes_(!d_.boxes.empty()),
-          mailbox_(mailbox), prims_(leaf_prims(s, d_.refs)) {}
+          mailbox_(mailbox) {}
 
     std::string_view name() const override { return name_; }
     bool emit_model(ModelSink& sink) const override;
@@ -164,11 +163,12 @@ private:
             const Node& n = nodes[e.node];
             if (n.leaf()) {
                 counting.leaf(e.depth, n.count);
-                for (const LeafPrim* p = &prims_[n.index]; p != &prims_[n.index] + n.count; ++p) {
+                for (std::uint32_t k = 0; k < n.count; ++k) {
+                    const std::uint32_t id = d_.refs[n.index + k];
                     if constexpr (kMailbox) {
-                        if (!mb->first_visit(p->id)) continue;
+                        if (!mb->first_visit(id)) continue;
                     }
-                    if (test_prim(*scene_, *p, ray, hit, counting)) {
+                    if (test_prim(*scene_, id, ray, hit, counting)) {
                         found = true;
                         if constexpr (Q == Query::Any) return true;
                     }
@@ -229,7 +229,6 @@ private:
     KdData d_;
     bool boxes_;
     bool mailbox_;
-    std::vector<LeafPrim> prims_;  ///< KdData::refs as their tests need them, in leaf order
 };
 
 }  // namespace rtcost::kd
