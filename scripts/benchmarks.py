@@ -23,8 +23,12 @@ def main():
     many = defaultdict(dict)   # (scene, dist) -> hierarchy -> Mrays/s of wall time
     build = defaultdict(dict)  # scene -> hierarchy -> (real ms, cpu ms)
     model = defaultdict(dict)  # scene -> hierarchy -> (ms, spd trace ms, share %)
+    # With --benchmark_repetitions, the medians stand for their repetitions.
+    medians = {b["run_name"] for b in data["benchmarks"] if b.get("aggregate_name") == "median"}
     for b in data["benchmarks"]:
-        if b.get("run_type") == "aggregate":
+        if b.get("run_type") == "aggregate" and b.get("aggregate_name") != "median":
+            continue
+        if b.get("run_type") != "aggregate" and b.get("run_name") in medians:
             continue
         parts = b["name"].split("/")
         if parts[0] == "trace":
@@ -32,7 +36,7 @@ def main():
             if threads == "1t":
                 one[(scene, dist)][h] = (b["Mrays/s"], b.get("bytes", 0), b.get("hit_pct", 0))
             else:
-                per_iter = b["wall_Mrays"] / b["iterations"]
+                per_iter = b["rays"] / 1e6
                 # Mrays per second of wall time, and per second of the process's CPU time
                 many[(scene, dist)][h] = (per_iter / (b["real_time"] / 1e3), per_iter / (b["cpu_time"] / 1e3))
         elif parts[0] == "build":
