@@ -1,6 +1,8 @@
-// Single-thread traversal and build benchmarks of rtcost's hierarchies against Embree on the same
-// scenes and the same rays, and the geometric estimator against tracing the `spd` rays. Run: build/bench/rtcost_bench [--benchmark_filter=...]
-// Scenes come from ../shared/scenes/spd when present (RTCOST_SHARED overrides), else built-ins.
+// Traversal (one thread and all cores) and build benchmarks of rtcost's hierarchies against
+// Embree on the same scenes and the same rays, and the geometric estimator against tracing the
+// `spd` rays. Run: build/bench/rtcost_bench [--benchmark_filter=...]; docs/benchmarks.md says how.
+// Scenes come from ../shared/scenes/spd when present (RTCOST_SHARED overrides), else built-ins;
+// meshes from RTCOST_BENCH_MESHES (default build/meshes), written by scripts/tessellate.py.
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -21,8 +23,8 @@ namespace {
 
 struct Workload {
     Scene scene;
-    std::map<std::string, std::vector<Ray>> rays;  // "random", "camera"
-    std::unique_ptr<RaySet> spd;                   // made on first use: a Whitted ray tree
+    std::map<std::string, RaySet> rays;  // by distribution, made on first use
+    std::unique_ptr<RaySet> spd;         // the model benchmark's: the scene's own camera size
 };
 
 std::string shared_dir() {
@@ -30,44 +32,91 @@ std::string shared_dir() {
     return RTCOST_SHARED_DIR;
 }
 
+/// Tessellated meshes written by scripts/tessellate.py (see docs/benchmarks.md) live here.
+std::string mesh_dir() {
+    if (const char* env = std::getenv("RTCOST_BENCH_MESHES")) return env;
+    return RTCOST_MESH_DIR;
+}
+
+std::string scene_path(const std::string& name) {
+    if (name.ends_with(".obj")) return mesh_dir() + "/" + name;
+    std::string path = shared_dir() + "/scenes/spd/" + name + ".nff";
+    return std::filesystem::exists(path) ? path : "builtin:" + name;
+}
+
 Workload& workload(const std::string& name) {
     static std::map<std::string, std::unique_ptr<Workload>> cache;
     auto& w = cache[name];
     if (!w) {
         w = std::make_unique<Workload>();
-        std::string path = shared_dir() + "/scenes/spd/" + name + ".nff";
-        w->scene = std::filesystem::exists(path) ? load_scene(path) : load_scene("builtin:" + name);
-        w->rays["random"] = random_rays(w->scene.bounds(), 1 << 16, 1);
-        w->rays["camera"] = camera_rays(w->scene.camera, 256, 256);
+        w->scene = load_scene(scene_path(name));
     }
     return *w;
 }
 
-void trace_bench(benchmark::State& state, std::string scene, std::string hierarchy, std::string dist) {
+/// "name" or "name+key=value+key=value" (the variants RTCOST_BENCH_EXTRA adds, for tuning).
+std::unique_ptr<Hierarchy> build_variant(const Scene& s, const std::string& spec) {
+    std::vector<std::string> parts;
+    for (std::size_t a = 0, b; a <= spec.size(); a = b + 1) {
+        b = spec.find('+', a);
+        if (b == std::string::npos) b = spec.size();
+        parts.push_back(spec.substr(a, b - a));
+    }
+    return build_hierarchy(s, parts[0], std::vector<std::string>(parts.begin() + 1, parts.end()));
+}
+
+/// The rays of distribution `dist` over the workload's scene: camera-based sets at 256 x 256
+/// (the tree distributions trace through their own BVH to make them), 65,536 random and aimed rays.
+const RaySet& rays_of(Workload& w, const std::string& dist) {
+    auto it = w.rays.find(dist);
+    if (it != w.rays.end()) return it->second;
+    RaySpec spec;
+    spec.name = dist;
+    spec.size = "256x256";
+    spec.count = 1 << 16;
+    return w.rays.emplace(dist, make_rays(w.scene, spec)).first->second;
+}
+
+/// Closest hits, occlusion for shadow rays. One thread (`threads` 1): a plain loop on the
+/// benchmark's thread, rays per second of its CPU time (so that other processes on a shared
+/// machine do not count). All cores (`threads` 0): the threaded runner, traversal alone, rays
+/// per second of wall time.
+void trace_bench(benchmark::State& state, std::string scene, std::string hierarchy, std::string dist, int threads) {
     Workload& w = workload(scene);
-    auto h = build_hierarchy(w.scene, hierarchy);
-    const auto& rays = w.rays.at(dist);
-    std::size_t hits = 0;
+    auto h = build_variant(w.scene, hierarchy);
+    const RaySet& set = rays_of(w, dist);
+    TraceOptions opt;
+    opt.threads = threads;
     if (h->lazy()) {
         // A lazily built structure grows during its first pass: time that pass as its build,
         // then the traversal of what the rays built.
-        auto start = std::chrono::steady_clock::now();
-        for (const Ray& r : rays) {
-            Hit hit;
-            h->closest(r, hit);
-        }
-        state.counters["lazy_build_s"] = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        state.counters["lazy_build_s"] = trace_ray_set(*h, set, opt).seconds;
     }
+    std::size_t hits = 0;
     for (auto _ : state) {
-        for (const Ray& r : rays) {
-            Hit hit;
-            h->closest(r, hit);
-            hits += hit.hit();
+        if (threads == 1) {
+            hits = 0;
+            for (std::size_t i = 0; i < set.rays.size(); ++i) {
+                Hit hit;
+                const RayKind k = set.kinds[i];
+                if (k == RayKind::Shadow || k == RayKind::AO) hits += h->any(set.rays[i], hit);
+                else {
+                    h->closest(set.rays[i], hit);
+                    hits += hit.hit();
+                }
+            }
+        } else {
+            TraceResult r = trace_ray_set(*h, set, opt);
+            state.SetIterationTime(r.seconds);
+            hits = r.hit_count;
         }
     }
-    benchmark::DoNotOptimize(hits);
-    state.counters["Mrays/s"] = benchmark::Counter(static_cast<double>(rays.size()) * state.iterations() / 1e6,
-                                                   benchmark::Counter::kIsRate);
+    const double n = static_cast<double>(set.rays.size()) * state.iterations() / 1e6;
+    // kIsRate divides by the CPU time of the benchmark's thread; the all-core rate is by wall time.
+    state.counters["Mrays/s"] = threads == 1 ? benchmark::Counter(n, benchmark::Counter::kIsRate) : benchmark::Counter(0);
+    state.counters["wall_Mrays"] = n;
+    state.counters["hit_pct"] = set.rays.empty() ? 0 : 100.0 * static_cast<double>(hits) / set.rays.size();
+    state.counters["rays"] = static_cast<double>(set.rays.size());
     state.counters["bytes"] = static_cast<double>(h->structure().bytes);
 }
 
@@ -77,7 +126,7 @@ void build_bench(benchmark::State& state, std::string scene, std::string hierarc
     std::vector<std::string> set;
     if (hierarchy == "embree") set.push_back("threads=1");
     for (auto _ : state) {
-        auto h = build_hierarchy(w.scene, hierarchy, set);
+        auto h = build_variant(w.scene, hierarchy + (set.empty() ? "" : "+" + set[0]));
         benchmark::DoNotOptimize(h.get());
     }
     state.counters["prims"] = static_cast<double>(w.scene.size());
@@ -94,7 +143,7 @@ void model_bench(benchmark::State& state, std::string scene, std::string hierarc
         RaySpec spec;
         spec.name = "spd";
         w.spd = std::make_unique<RaySet>(make_rays(w.scene, spec));
-    }
+    }  // the scene's own camera size, as `rtcost trace --rays spd`
     TraceOptions t;
     t.threads = 1;
     if (h->lazy()) trace_ray_set(*h, *w.spd, t);  // the first pass builds what the rays need
@@ -115,22 +164,43 @@ void model_bench(benchmark::State& state, std::string scene, std::string hierarc
 }  // namespace
 
 int main(int argc, char** argv) {
-    const std::vector<std::string> scenes = {"tetra", "balls", "mount-s8"};
-    std::vector<std::string> hier;
-    for (const char* h : {"embree", "bvh-sah", "bvh-median", "bvh-gs", "kd-sah", "kd-median", "bsp", "octree", "grid",
-                          "rc5d"})
-        if (find_hierarchy(h)) hier.push_back(h);
-    for (const auto& s : scenes) {
-        for (const auto& h : hier) {
-            if (h != "embree")
+    // The model benchmarks: every modelled hierarchy on three SPD scenes.
+    const std::vector<std::string> model_scenes = {"tetra", "balls", "mount-s8"};
+    std::vector<std::string> all;
+    for (const HierarchyInfo* info : hierarchies()) all.push_back(info->name);
+    for (const auto& s : model_scenes)
+        for (const auto& h : all)
+            if (h != "embree" && h != "brute")
                 benchmark::RegisterBenchmark(("model/" + s + "/" + h).c_str(), model_bench, s, h)
                     ->Unit(benchmark::kMillisecond)
                     ->MinTime(0.2);
-            for (const char* d : {"random", "camera"}) {
-                benchmark::RegisterBenchmark(("trace/" + s + "/" + d + "/" + h).c_str(), trace_bench, s, h, d)
-                    ->Unit(benchmark::kMillisecond)
-                    ->MinTime(0.5);
-            }
+    // Traversal against Embree on the rays that matter, one thread and all cores (names end in
+    // /1t and /mt: run the /1t ones pinned to one core), on mount-s8 and two tessellated meshes;
+    // `random` rays (most miss) once per scene. Builds on one thread.
+    std::vector<std::string> scenes = {"mount-s8"};
+    for (const char* m : {"balls-mesh.obj", "rings-mesh.obj"})
+        if (std::filesystem::exists(mesh_dir() + "/" + m)) scenes.push_back(m);
+    std::vector<std::string> hier = {"embree", "bvh-wide", "bvh-sah", "kd-sah"};
+    if (const char* extra = std::getenv("RTCOST_BENCH_EXTRA")) {
+        std::string e = extra;
+        for (std::size_t a = 0, b; a < e.size(); a = b + 1) {
+            b = e.find(',', a);
+            if (b == std::string::npos) b = e.size();
+            hier.push_back(e.substr(a, b - a));
+        }
+    }
+    for (const auto& s : scenes) {
+        for (const auto& h : hier) {
+            for (const char* d : {"camera", "spd", "diffuse", "shadow", "aimed", "random"})
+                for (int threads : {1, 0}) {
+                    auto* b = benchmark::RegisterBenchmark(
+                        ("trace/" + s + "/" + d + "/" + h + (threads == 1 ? "/1t" : "/mt")).c_str(), trace_bench, s,
+                        h, d, threads);
+                    b->Unit(benchmark::kMillisecond)->MinTime(0.5);
+                    // All cores: wall time of the traversal, and the process's CPU time over all its
+                    // threads (which a shared machine's other load does not inflate).
+                    if (threads != 1) b->UseManualTime()->MeasureProcessCPUTime();
+                }
             benchmark::RegisterBenchmark(("build/" + s + "/" + h).c_str(), build_bench, s, h)
                 ->Unit(benchmark::kMillisecond)
                 ->MinTime(0.5);

@@ -64,6 +64,7 @@ TEST(ModelSampled, ReproducesTheTrainingRaysCountsForEveryHierarchyAndQuery) {
     rays.insert(rays.end(), more.begin(), more.end());
     const std::vector<Variant> variants = {
         {"bvh-median", {}},   {"bvh-gs", {}},       {"bvh-sah", {}},      {"bvh-sah", {"order=none"}},
+        {"bvh-wide", {}},     {"bvh-wide", {"width=4"}},
         {"kd-median", {}},    {"kd-sah", {}},       {"grid", {}},         {"grid", {"res=woo"}},
         {"bsp", {}},          {"bsp", {"traversal=recursive"}},           {"octree", {}},
         {"octree", {"traversal=recursive", "max_prims=2"}},               {"rc5d", {"build=eager", "max_depth=10"}},

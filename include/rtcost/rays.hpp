@@ -28,6 +28,11 @@ std::vector<Ray> line_rays(const Box3& box, std::size_t n, std::uint64_t seed);
 /// (so some start inside and some outside), directions uniform on the sphere, (0, +inf).
 std::vector<Ray> random_rays(const Box3& box, std::size_t n, std::uint64_t seed);
 
+/// `n` incoherent rays that nearly all hit: origins uniform on a sphere around the scene (twice
+/// its bounding sphere), each aimed at a uniformly random point of a primitive chosen uniformly
+/// at random; unit directions, (0, +inf).
+std::vector<Ray> aimed_rays(const Scene& scene, std::size_t n, std::uint64_t seed);
+
 /// What a ray in a ray set is for. Generated distributions are all `Eye` or `Line`; the SPD
 /// Whitted tree mixes eye, reflection, refraction and shadow rays.
 enum class RayKind : std::uint8_t { Eye, Reflection, Refraction, Shadow, Diffuse, AO, Line, Test, File };
@@ -59,12 +64,12 @@ struct ViewSpec {
 /// naming the option for a malformed or degenerate one.
 void apply_view(Scene& scene, const ViewSpec& view);
 
-/// How to make a ray set: `name` is a distribution (camera, lines, random, spd, shadow, diffuse,
-/// ao) or a ray file path.
+/// How to make a ray set: `name` is a distribution (camera, lines, random, aimed, spd, shadow,
+/// diffuse, ao) or a ray file path.
 struct RaySpec {
     std::string name = "camera";
     std::string size;                 ///< "WxH" for camera-based distributions; empty: the scene's
-    std::size_t count = 100000;       ///< rays for lines and random
+    std::size_t count = 100000;       ///< rays for lines, random and aimed
     std::uint64_t seed = 1;
     ViewSpec view;                    ///< camera and lights (see apply_view; make_rays reads the scene's)
 };

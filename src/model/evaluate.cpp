@@ -341,7 +341,7 @@ EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& 
         split = "sample";
     }
     if (wants(opt, Estimator::Sampled)) {
-        if (spec.name == "lines" || spec.name == "random") {
+        if (spec.name == "lines" || spec.name == "random" || spec.name == "aimed") {
             // A fresh draw of the same distribution with another seed.
             RaySpec t = spec;
             t.seed = spec.seed + 7919;

@@ -29,7 +29,7 @@ std::string_view ray_kind_name(RayKind k) {
 
 bool is_occlusion(RayKind kind) { return kind == RayKind::Shadow || kind == RayKind::AO; }
 
-std::vector<std::string> distribution_names() { return {"camera", "spd", "shadow", "diffuse", "ao", "lines", "random"}; }
+std::vector<std::string> distribution_names() { return {"camera", "spd", "shadow", "diffuse", "ao", "lines", "random", "aimed"}; }
 
 namespace {
 RaySet uniform(std::vector<Ray> rays, RayKind kind, std::string described) {
@@ -102,6 +102,9 @@ RaySet make_rays(const Scene& scene, const RaySpec& spec) {
     if (spec.name == "random")
         return uniform(random_rays(scene.bounds(), spec.count, spec.seed), RayKind::Test,
                        fmt::format("random {} seed {}", spec.count, spec.seed));
+    if (spec.name == "aimed")
+        return uniform(aimed_rays(scene, spec.count, spec.seed), RayKind::Test,
+                       fmt::format("aimed {} seed {}", spec.count, spec.seed));
     if (is_tree_distribution(spec.name)) return make_tree_rays(scene, spec);
     if (std::error_code ec; !std::filesystem::exists(spec.name, ec)) {
         std::string names;

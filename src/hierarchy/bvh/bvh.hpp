@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rtcost/hierarchy.hpp"
+#include "../common/leaf_prims.hpp"
 
 namespace rtcost::bvh {
 
@@ -58,8 +59,7 @@ BvhData build_sah(const Scene& s, const SahOptions& o);
 /// stored order, and no subtree is cut by a hit found (the paper's BVH case).
 class Bvh final : public HierarchyImpl<Bvh> {
 public:
-    Bvh(const Scene& s, std::string name, BvhData data, bool ordered)
-        : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered) {}
+    Bvh(const Scene& s, std::string name, BvhData data, bool ordered);
 
     std::string_view name() const override { return name_; }
     bool emit_model(ModelSink& sink) const override;
@@ -103,8 +103,8 @@ private:
                 const Node& n = nodes[e.node];
                 if (n.leaf) {
                     counting.leaf(e.depth, n.count);
-                    for (std::uint32_t k = 0; k < n.count; ++k) {
-                        if (test_prim(*scene_, d_.refs[n.index + k], ray, hit, counting)) {
+                    for (const LeafPrim* p = &prims_[n.index]; p != &prims_[n.index] + n.count; ++p) {
+                        if (test_prim(*scene_, *p, ray, hit, counting)) {
                             found = true;
                             if constexpr (Q == Query::Any) return true;
                         }
@@ -125,7 +125,10 @@ private:
                         if (tb < ta) std::swap(a, b);
                     }
                     if (a.t != kInf) {
-                        if (b.t != kInf) stack[sp++] = b;
+                        if (b.t != kInf) {
+                            stack[sp++] = b;
+                            prefetch(nodes[b.node]);
+                        }
                         e = a;
                         continue;
                     }
@@ -162,9 +165,16 @@ private:
         return found;
     }
 
+    /// Incoherent rays wait on memory: what a visit of `n` reads first, fetched ahead.
+    void prefetch(const Node& n) const {
+        if (n.leaf) __builtin_prefetch(prims_.data() + n.index);
+        else __builtin_prefetch(d_.nodes.data() + n.index);
+    }
+
     std::string name_;
     BvhData d_;
     bool ordered_;
+    std::vector<LeafPrim> prims_;  ///< BvhData::refs as their tests need them, in leaf order
 };
 
 }  // namespace rtcost::bvh

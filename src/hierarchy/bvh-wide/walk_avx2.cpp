@@ -1,0 +1,87 @@
+// bvh-wide traversals compiled for AVX2 (eight lanes in one register), chosen at build time when
+// the CPU runs AVX2. Only the code in namespace `avx2` below is compiled for that target; what it
+// calls from the library's headers (the primitives' intersection) stays baseline code, so the
+// hits are the same bit for bit as every other traversal's.
+#include <algorithm>
+#include <utility>
+
+#include "wide.hpp"
+
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#include <immintrin.h>
+
+namespace rtcost::wide {
+
+bool cpu_has_avx2() {
+    __builtin_cpu_init();
+    return __builtin_cpu_supports("avx2");
+}
+
+#if defined(__clang__)
+#pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
+#else
+#pragma GCC push_options
+#pragma GCC target("avx2")
+#endif
+
+namespace avx2 {
+
+struct P4 {
+    __m128 v;
+    static P4 load(const float* p) { return {_mm_load_ps(p)}; }
+    static P4 splat(float x) { return {_mm_set1_ps(x)}; }
+    static P4 sub(P4 a, P4 b) { return {_mm_sub_ps(a.v, b.v)}; }
+    static P4 mul(P4 a, P4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+    static P4 max(P4 a, P4 b) { return {_mm_max_ps(a.v, b.v)}; }  // a > b ? a : b
+    static P4 min(P4 a, P4 b) { return {_mm_min_ps(a.v, b.v)}; }
+    static unsigned le(P4 a, P4 b) { return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(a.v, b.v))); }
+    void store(float* p) const { _mm_store_ps(p, v); }
+};
+
+struct P8 {
+    __m256 v;
+    static P8 load(const float* p) { return {_mm256_load_ps(p)}; }
+    static P8 splat(float x) { return {_mm256_set1_ps(x)}; }
+    static P8 sub(P8 a, P8 b) { return {_mm256_sub_ps(a.v, b.v)}; }
+    static P8 mul(P8 a, P8 b) { return {_mm256_mul_ps(a.v, b.v)}; }
+    static P8 add(P8 a, P8 b) { return {_mm256_add_ps(a.v, b.v)}; }
+    static P8 div(P8 a, P8 b) { return {_mm256_div_ps(a.v, b.v)}; }
+    static __m256 lt(P8 a, P8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ); }
+    static __m256 gt(P8 a, P8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ); }
+    static __m256 eq(P8 a, P8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ); }
+    static __m256 neq(P8 a, P8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_NEQ_UQ); }  // true when unordered
+    static __m256 mand(__m256 a, __m256 b) { return _mm256_and_ps(a, b); }
+    static __m256 mor(__m256 a, __m256 b) { return _mm256_or_ps(a, b); }
+    static unsigned bits(__m256 m) { return static_cast<unsigned>(_mm256_movemask_ps(m)); }
+    static P8 max(P8 a, P8 b) { return {_mm256_max_ps(a.v, b.v)}; }  // a > b ? a : b
+    static P8 min(P8 a, P8 b) { return {_mm256_min_ps(a.v, b.v)}; }  // a < b ? a : b
+    static unsigned le(P8 a, P8 b) {
+        return static_cast<unsigned>(_mm256_movemask_ps(_mm256_cmp_ps(a.v, b.v, _CMP_LE_OQ)));
+    }
+    void store(float* p) const { _mm256_store_ps(p, v); }
+};
+
+#include "walk.inc"
+
+Walks make(int width) { return width == 8 ? make_walks<P8, 8, P8, 8>() : make_walks<P4, 4, P8, 8>(); }
+
+}  // namespace avx2
+
+#if defined(__clang__)
+#pragma clang attribute pop
+#else
+#pragma GCC pop_options
+#endif
+
+Walks walks_avx2(int width) { return avx2::make(width); }
+
+}  // namespace rtcost::wide
+
+#else
+
+namespace rtcost::wide {
+bool cpu_has_avx2() { return false; }
+Walks walks_avx2(int width) { return walks_baseline(width); }
+}  // namespace rtcost::wide
+
+#endif

@@ -1,0 +1,109 @@
+#pragma once
+// bvh-wide: a 4- or 8-wide BVH collapsed from the binned SAH tree, its children's boxes stored
+// as arrays (one lane per child) so that one SIMD slab test meets all of them at once.
+//
+// The traversals live in per-instruction-set files (walk_sse.cpp, walk_avx2.cpp), each compiled
+// for its own target inside its own namespace, and are chosen once per build by what the CPU
+// runs: the library itself is built for the baseline x86-64, not -march=native. Hand-written
+// intrinsics rather than a SIMD library (Highway, xsimd): the traversal needs five operations
+// (sub, mul, min, max, compare-to-mask) on two fixed widths, and runtime dispatch among the
+// two targets is two function tables; a library would add a dependency for that.
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rtcost/hierarchy.hpp"
+
+namespace rtcost::wide {
+
+/// One wide node of `W` lanes (a lane per child): 32 W bytes, a multiple of the cache line.
+/// `b[2 a]` holds the children's lower bounds on axis a, `b[2 a + 1]` the upper ones. An unused
+/// lane has an empty box (+inf, -inf), which no slab test accepts, and `child == kEmpty`.
+template <int W>
+struct alignas(64) Node {
+    float b[6][W];
+    /// Interior child: its node index. Leaf child: kLeaf | first primitive slot.
+    std::uint32_t child[W];
+    /// Leaf child: its number of primitives; interior child: its number of used lanes.
+    std::uint32_t count[W];
+};
+
+inline constexpr std::uint32_t kLeaf = 0x80000000u;
+inline constexpr std::uint32_t kEmpty = 0xffffffffu;
+/// Bound on depth (the collapsed tree is never deeper than the binary one).
+inline constexpr int kMaxDepth = 100;
+
+/// A leaf's primitive other than a triangle (or a three-vertex polygon): tested through
+/// Scene::intersect, as test_prim does.
+struct Other {
+    std::uint32_t id = 0;
+    PrimKind kind = PrimKind::Sphere;
+};
+
+/// `K` triangles of a leaf (triangles and three-vertex polygons) side by side, one lane each:
+/// `v[3 i + a]` is vertex i's coordinate on axis a. Lanes past the leaf's count are unused.
+template <int K>
+struct alignas(32) TriPack {
+    float v[9][K];
+    std::uint32_t id[K];
+    PrimKind kind[K];
+};
+
+/// A leaf's storage begins at a multiple of this many bytes in the leaf arena.
+inline constexpr std::size_t kLeafAlign = 32;
+
+/// What a traversal reads: the nodes of one width, and the leaves in leaf order. A leaf lane's
+/// `child` is kLeaf | (its offset in `leaves` / kLeafAlign) and its `count` packs the
+/// triangles (low 16 bits) and the other primitives (high 16 bits). At that offset lie
+/// ceil(triangles / tri_lanes) TriPack<tri_lanes>, then the other primitives as Other records.
+struct View {
+    const void* nodes = nullptr;
+    int width = 8;
+    Box3 root_box;
+    std::uint32_t root_count = 0;       ///< lanes used in the root
+    const std::byte* leaves = nullptr;
+    int tri_lanes = 4;  ///< 4 for the baseline traversal, 8 for AVX2
+    const Scene* scene = nullptr;
+};
+
+/// One traversal instantiation: closest, any or all, with or without counting.
+template <class C>
+using WalkFn = bool (*)(const View&, const Ray&, Hit&, C&);
+struct Walks {
+    WalkFn<NoCount> fast[3] = {};  ///< indexed by Query
+    WalkFn<Count> counted[3] = {};
+};
+
+/// The traversals compiled for the baseline (SSE2 on x86-64, plain loops elsewhere) and, on
+/// x86-64, for AVX2; `width` is 4 or 8.
+Walks walks_baseline(int width);
+Walks walks_avx2(int width);
+/// Whether this CPU (and its operating system) runs AVX2.
+bool cpu_has_avx2();
+
+class BvhWide final : public HierarchyImpl<BvhWide> {
+public:
+    struct Data;
+    BvhWide(const Scene& s, std::unique_ptr<Data> d, Walks walks);
+    ~BvhWide() override;
+
+    std::string_view name() const override { return "bvh-wide"; }
+    bool emit_model(ModelSink& sink) const override;
+
+    template <class C, Query Q>
+    bool trace(const Ray& ray, Hit& hit, C& counting) const {
+        if constexpr (C::enabled) return walks_.counted[static_cast<int>(Q)](view_, ray, hit, counting);
+        else return walks_.fast[static_cast<int>(Q)](view_, ray, hit, counting);
+    }
+
+protected:
+    StructureStats compute_structure() const override;
+
+private:
+    std::unique_ptr<Data> d_;
+    View view_;
+    Walks walks_;
+};
+
+}  // namespace rtcost::wide

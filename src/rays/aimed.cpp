@@ -1,0 +1,98 @@
+// `aimed` rays: incoherent rays that nearly all hit. Each starts at a uniform point of a sphere
+// around the scene (twice its bounding sphere) and points at a uniformly random point of a
+// primitive chosen uniformly at random, so it meets that primitive or something in front of it.
+#include <cmath>
+#include <numbers>
+#include <random>
+
+#include "rtcost/rays.hpp"
+
+namespace rtcost {
+namespace {
+
+// The same construction as the other distributions (raw 53 bits of mt19937_64), so the rays are
+// identical across standard libraries.
+struct Rng {
+    std::mt19937_64 engine;
+    explicit Rng(std::uint64_t seed) : engine(seed) {}
+    double uniform() { return static_cast<double>(engine() >> 11) * 0x1p-53; }
+    Vec3 direction() {
+        double z = 1 - 2 * uniform();
+        double phi = 2 * std::numbers::pi * uniform();
+        double r = std::sqrt(std::max(0.0, 1 - z * z));
+        return {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
+    }
+};
+
+Vec3 on_triangle(Vec3 a, Vec3 b, Vec3 c, Rng& rng) {
+    const double s = std::sqrt(rng.uniform()), u = rng.uniform();
+    const float wa = static_cast<float>(1 - s), wb = static_cast<float>(s * (1 - u)), wc = static_cast<float>(s * u);
+    return a * wa + b * wb + c * wc;
+}
+
+/// A uniform point of the polygon's fan from its first vertex, each triangle weighed by its
+/// area (exact for convex polygons; a concave one may give a point just outside it).
+Vec3 on_polygon(const Polygon& p, const std::vector<Vec3>& pool, Rng& rng) {
+    const Vec3* v = pool.data() + p.first;
+    double total = 0;
+    for (std::uint32_t i = 1; i + 1 < p.count; ++i) total += length(cross(v[i] - v[0], v[i + 1] - v[0]));
+    double pick = rng.uniform() * total;
+    std::uint32_t i = 1;
+    for (; i + 2 < p.count; ++i) {
+        pick -= length(cross(v[i] - v[0], v[i + 1] - v[0]));
+        if (pick <= 0) break;
+    }
+    return on_triangle(v[0], v[i], v[i + 1], rng);
+}
+
+/// A uniform point of the cone's lateral surface: the axial position by the inverse of its
+/// area distribution (density in proportion to the radius there), then a uniform angle.
+Vec3 on_cone(const Cone& c, Rng& rng) {
+    const Vec3 axis = c.apex - c.base;
+    const Vec3 w = normalize(axis);
+    const Vec3 a = std::fabs(w.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
+    const Vec3 e1 = normalize(cross(w, a)), e2 = cross(w, e1);
+    const double rb = std::fabs(c.base_radius), ra = std::fabs(c.apex_radius), k = ra - rb;
+    const double x = rng.uniform() * (rb + 0.5 * k);  // the area up to s is rb s + k s^2 / 2
+    const double s = std::fabs(k) < 1e-12 * (rb + ra) ? x / rb : (-rb + std::sqrt(rb * rb + 2 * k * x)) / k;
+    const double r = rb + k * s, phi = 2 * std::numbers::pi * rng.uniform();
+    return c.base + axis * static_cast<float>(s) + e1 * static_cast<float>(r * std::cos(phi)) +
+           e2 * static_cast<float>(r * std::sin(phi));
+}
+
+}  // namespace
+
+std::vector<Ray> aimed_rays(const Scene& scene, std::size_t n, std::uint64_t seed) {
+    std::vector<Ray> rays;
+    if (scene.empty()) return rays;
+    rays.reserve(n);
+    Rng rng(seed);
+    const Vec3 centre = scene.bounds().center();
+    const float radius = std::max(length(scene.bounds().extent()), 1e-30f);  // twice the half-diagonal
+    while (rays.size() < n) {
+        const Vec3 o = centre + rng.direction() * radius;
+        const auto id = static_cast<std::uint32_t>(rng.uniform() * static_cast<double>(scene.size()));
+        const PrimRef& p = scene.prims[std::min<std::size_t>(id, scene.size() - 1)];
+        Vec3 target;
+        switch (p.kind) {
+            case PrimKind::Triangle: {
+                const Triangle& t = scene.triangles[p.index];
+                target = on_triangle(t.v0, t.v1, t.v2, rng);
+                break;
+            }
+            case PrimKind::Polygon: target = on_polygon(scene.polygons[p.index], scene.polygon_vertices, rng); break;
+            case PrimKind::Sphere: {
+                const Sphere& s = scene.spheres[p.index];
+                target = s.center + rng.direction() * std::fabs(s.radius);
+                break;
+            }
+            case PrimKind::Cone: target = on_cone(scene.cones[p.index], rng); break;
+        }
+        const Vec3 d = target - o;
+        if (!(length(d) > 0) || !is_finite(d)) continue;
+        rays.push_back(Ray{o, normalize(d), 0, kInf});
+    }
+    return rays;
+}
+
+}  // namespace rtcost
