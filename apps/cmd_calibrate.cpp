@@ -1,5 +1,9 @@
 // `rtcost calibrate`: fit nanoseconds per operation kind to measured single-thread times.
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
+#include <unistd.h>
 
 #include "cli.hpp"
 #include "rtcost/model.hpp"
@@ -29,6 +33,7 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
             start = comma + 1;
         }
     }
+    check_output_path(a.out, "--out");
     std::vector<CalibrationSample> samples;
     Progress progress("calibrate", a.scenes.size() * names.size(), common.quiet || common.json);
     for (const std::string& spec : a.scenes) {
@@ -54,7 +59,19 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     }
     progress.finish();
     Calibration c = calibrate(samples);
-    write_costs(a.out, c, samples);
+    // write_costs renames its own temporary over the path, which would replace a device or a
+    // link; it writes to a private temporary here, copied onto the output by write_file_atomic.
+    {
+        namespace fs = std::filesystem;
+        const fs::path tmp = fs::temp_directory_path() / fmt::format("rtcost-costs-{}.json", ::getpid());
+        write_costs(tmp.string(), c, samples);
+        std::ifstream in(tmp, std::ios::binary);
+        std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        in.close();
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        write_file_atomic(a.out, bytes);
+    }
 
     static const char* kKinds[] = {"box", "plane", "hop", "classify"};
     if (common.json) {

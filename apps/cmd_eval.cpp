@@ -140,6 +140,9 @@ int cmd_eval(EvalArgs& a, const Common& common) {
             test = std::move(keep);
         }
     }
+    if (sampled && (train.rays.empty() || test.rays.empty()))
+        throw InputError("--rays", 0, fmt::format("the sampled estimator needs training and test rays; {} gives {} and {} "
+                                                  "(use more rays)", described, train.rays.size(), test.rays.size()));
     ModelOptions mo;
     mo.preset = a.preset == "paper" ? Preset::Paper : Preset::Exact;
     mo.query = parse_query(a.query);

@@ -18,13 +18,14 @@ struct RenderArgs {
 };
 
 int cmd_render(const RenderArgs& a, const Common& common) {
+    check_output_path(a.out, "--out");
     Scene scene = load(a.b.scene, common);
     RenderOptions opt;
     opt.width = scene.camera.width;
     opt.height = scene.camera.height;
     if (!a.size.empty()) parse_size(a.size, "--size", opt.width, opt.height);
     opt.max_depth = a.depth;
-    opt.threads = a.threads;
+    opt.threads = checked_threads(a.threads, common.quiet || common.json);
     auto h = build(scene, a.b, common);
     Image img;
     auto start = std::chrono::steady_clock::now();

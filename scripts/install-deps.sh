@@ -11,6 +11,7 @@ packages=(
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libpng-dev libstb-dev              # images
   libgtest-dev libgmock-dev libbenchmark-dev
+  clang libclang-rt-14-dev llvm      # sanitizer builds, libFuzzer, symbolised reports
 )
 
 missing=()

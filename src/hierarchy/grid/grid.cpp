@@ -119,6 +119,8 @@ Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool 
     if (empty_) {
         res_ = {1, 1, 1};
         box_ = Box3{{0, 0, 0}, {0, 0, 0}};
+    } else {
+        limit_references(s);
     }
     // Boundaries in double, rounded once: non-decreasing, first and last exactly the box faces.
     for (int a = 0; a < 3; ++a) {
@@ -172,8 +174,42 @@ Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool 
     for (std::size_t p = 0; p < pair_id.size(); ++p) refs_[fill[pair_cell[p]]++] = pair_id[p];
 }
 
+// Coincident primitives, or long thin ones spanning the scene, overlap nearly every cell: the
+// references grow as cells x primitives (10,000 copies of a triangle: 400 MB, and every ray
+// tests every copy in every cell). The resolution is reduced, all axes alike, until the
+// references that the primitives' boxes imply are at most kRefsPerPrim per primitive (or
+// kMinRefBudget); no SPD scene comes near it at the default density.
+void Grid::limit_references(const Scene& s) {
+    const std::uint64_t budget = std::max<std::uint64_t>(kMinRefBudget, kRefsPerPrim * s.size());
+    auto count = [&](const std::array<int, 3>& r) {
+        std::uint64_t total = 0;
+        for (std::uint32_t id = 0; id < s.size() && total <= budget; ++id) {
+            const Box3 pb = s.prim_bounds(id);
+            std::uint64_t n = 1;
+            for (int a = 0; a < 3; ++a) {
+                const double ext = double(box_.hi[a]) - box_.lo[a];
+                if (!(ext > 0) || r[a] == 1) continue;
+                const double f = r[a] / ext;
+                const double lo = std::clamp(std::floor((pb.lo[a] - double(box_.lo[a])) * f), 0.0, r[a] - 1.0);
+                const double hi = std::clamp(std::floor((pb.hi[a] - double(box_.lo[a])) * f), 0.0, r[a] - 1.0);
+                n *= static_cast<std::uint64_t>(hi - lo) + 2;  // one more: a box on a boundary
+            }
+            total += n;
+        }
+        return total;
+    };
+    const std::array<int, 3> asked = res_;
+    while (product(res_) > 1 && count(res_) > budget)
+        for (int& r : res_) r = std::max(1, static_cast<int>(r * 0.8));
+    if (res_ != asked)
+        limits_.push_back(fmt::format("grid: resolution {}x{}x{} reduced to {}x{}x{}: the primitives' boxes overlap "
+                                      "so many cells that the references would exceed {} ({} per primitive)",
+                                      asked[0], asked[1], asked[2], res_[0], res_[1], res_[2], budget, kRefsPerPrim));
+}
+
 StructureStats Grid::compute_structure() const {
     StructureStats s;
+    s.limits = limits_;
     s.interior = 1;  // the grid itself: the one node a ray enters before its first cell
     s.leaves = cell_count();
     for (std::uint64_t c = 0; c < cell_count(); ++c) s.empty_leaves += offsets_[c] == offsets_[c + 1];
