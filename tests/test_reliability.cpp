@@ -80,6 +80,36 @@ TEST(Reliability, ShortConeHasBoundsAndANormal) {
     EXPECT_TRUE(is_finite(normal_at(Triangle{{0, 0, 0}, {1e-30f, 0, 0}, {0, 1e-30f, 0}})));
 }
 
+TEST(Reliability, ConeHitsLieOnTheSurfaceEvenForAFlatCone) {
+    // Every reported hit's point must be on the frustum: at axial distance s in [0, h] and at
+    // distance rb + k s from the axis (to 1e-4 of the larger radius). The flat one (radius 2e9,
+    // axis 1) once gave false hits.
+    const Cone cones[] = {{{0, 0, 0}, 2e9f, {0, 0, 1}, 1}, {{0, 0, 0}, 1, {0, 0, 2}, 0.5f}, {{1, 2, 3}, 0, {2, 2, 3}, 3}};
+    std::mt19937 rng(4);
+    for (const Cone& c : cones) {
+        const Box3 b = bounds(c);
+        const double h = length(c.apex - c.base);
+        const double rmax = std::max(c.base_radius, c.apex_radius);
+        std::size_t hits = 0;
+        for (const Ray& r : random_rays(b, 20000, 6)) {
+            float t = 0;
+            if (!intersect(c, r, t)) continue;
+            ++hits;
+            const double px = double(r.o.x) + double(r.d.x) * t - c.base.x, py = double(r.o.y) + double(r.d.y) * t - c.base.y,
+                         pz = double(r.o.z) + double(r.d.z) * t - c.base.z;
+            const double wx = (c.apex.x - c.base.x) / h, wy = (c.apex.y - c.base.y) / h, wz = (c.apex.z - c.base.z) / h;
+            const double sa = px * wx + py * wy + pz * wz;
+            const double qx = px - sa * wx, qy = py - sa * wy, qz = pz - sa * wz;
+            const double radial = std::sqrt(qx * qx + qy * qy + qz * qz);
+            const double want = c.base_radius + (c.apex_radius - c.base_radius) * sa / h;
+            EXPECT_NEAR(radial, want, 1e-4 * rmax) << "cone " << c.base_radius << " s " << sa;
+            EXPECT_GE(sa, -1e-4 * (h + rmax));
+            EXPECT_LE(sa, h + 1e-4 * (h + rmax));
+        }
+        EXPECT_GT(hits, 100u);
+    }
+}
+
 // ---- load-time limits ----
 
 TEST(Reliability, CoordinatesBeyondTheLimitAreRefusedWithTheLimit) {

@@ -1,4 +1,5 @@
 // Exact ray intersection, bounds and area of the four primitive kinds.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -215,8 +216,11 @@ bool intersect(const Cone& cone, const Ray& ray, float& t) {
     const double C = dot(r0, r0) - m * m;
     double roots[2];
     int n = 0;
-    const double scale = dot(d, d);
-    if (std::fabs(A) <= 1e-12 * scale) {
+    // A is a difference of two terms; for a flat cone (k large) each is far larger than |d|^2,
+    // and A's rounding is relative to them: a ray along a generator must not get a root from
+    // a rounded A of the wrong sign (a false hit on a cone of radius 2e9 and axis 1).
+    const double scale = dot(rd, rd) + k * k * ds * ds;
+    if (std::fabs(A) <= 1e-12 * std::max(scale, dot(d, d))) {
         if (B == 0) return false;  // parallel to a generator: the line lies on or off the surface
         roots[n++] = -C / (2 * B);
     } else {

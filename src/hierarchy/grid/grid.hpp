@@ -69,6 +69,9 @@ private:
     /// Most references per primitive (and at least kMinRefBudget in all) before the resolution
     /// is reduced; see limit_references.
     static constexpr std::uint64_t kRefsPerPrim = 16, kMinRefBudget = std::uint64_t{1} << 20;
+    /// Expected primitive tests per ray, in units of the primitive count, before the
+    /// resolution is reduced; see limit_references.
+    static constexpr int kTestsPerPrim = 2, kMinTests = 64;
     void limit_references(const Scene& s);
     std::vector<std::string> limits_;
 
