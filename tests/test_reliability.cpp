@@ -203,6 +203,25 @@ TEST(Reliability, Rc5dAlwaysHasAMemoryCapAndReportsReachingIt) {
     EXPECT_TRUE(contains(st.limits[0], "max_bytes=200000")) << st.limits[0];
 }
 
+TEST(Reliability, RaysOfDirectionMinusZeroInABoxFaceAreNotLost) {
+    // Found by the ray-file fuzzer: origin on the plane x = 0 (a kd-median node's face), direction
+    // (-0, 0, -1). The slab test's compare-and-swap met a NaN and rejected the ray on both sides.
+    Scene s = builtin_scene("balls", 1);
+    std::vector<Ray> rays;
+    for (float dx : {0.0f, -0.0f})
+        for (float dy : {0.0f, -0.0f})
+            for (Vec3 o : {Vec3{0, 0, 0}, Vec3{0, 0, 1.1754944e-38f}, Vec3{0, 0.3f, 0.2f}, Vec3{-12, 0, 0.1f}})
+                rays.push_back({o, {dx, dy, -1}, 0, kInf});
+    for (const Ray& r : std::vector<Ray>(rays)) rays.push_back({r.o, {r.d.x, -1, r.d.y}, 0, kInf});
+    std::vector<Variant> all;
+    for (const HierarchyInfo* h : hierarchies())
+        if (h->name != "embree" && h->name != "brute") all.push_back({h->name, {}});
+    all.push_back({"kd-sah", {"assign=exact"}});
+    all.push_back({"bsp", {"traversal=recursive"}});
+    all.push_back({"octree", {"traversal=recursive"}});
+    expect_variants_match_brute(s, rays, "-0 in a face", all);
+}
+
 // ---- rays ----
 
 TEST(Reliability, RayFilesOutsideWhatTracingHandlesAreRefused) {

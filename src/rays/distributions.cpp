@@ -82,8 +82,8 @@ std::vector<Ray> line_rays(const Box3& box, std::size_t n, std::uint64_t seed) {
         RayInv ri(Ray{o, d, -kInf, kInf});
         float t0 = -kInf, t1 = kInf;
         for (int k = 0; k < 3; ++k) {
-            float tn = (box.lo[k] - o[k]) * ri.inv[k], tf = (box.hi[k] - o[k]) * ri.inv[k];
-            if (tn > tf) std::swap(tn, tf);
+            float tn = ((ri.neg[k] ? box.hi[k] : box.lo[k]) - o[k]) * ri.inv[k];
+            float tf = ((ri.neg[k] ? box.lo[k] : box.hi[k]) - o[k]) * ri.inv[k];
             t0 = tn > t0 ? tn : t0;
             t1 = tf < t1 ? tf : t1;
         }
