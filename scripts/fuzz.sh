@@ -27,7 +27,7 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 for f in $fuzzers; do
   mkdir -p "$b/corpus/$f"
   echo "fuzz: $f for ${seconds}s"
-  if ! $b/fuzz/fuzz_$f -max_total_time="$seconds" -timeout=20 -rss_limit_mb=3072 -max_len=4096 \
+  if ! $b/fuzz/fuzz_$f -max_total_time="$seconds" -timeout=120 -rss_limit_mb=3072 -max_len=4096 \
       -artifact_prefix="$b/findings/$f-" -print_final_stats=1 \
       "$b/corpus/$f" "fuzz/corpus/$f" 2> "$b/fuzz-$f.log"; then
     echo "fuzz: $f FOUND a problem ($b/fuzz-$f.log, $b/findings/)"; tail -40 "$b/fuzz-$f.log"
