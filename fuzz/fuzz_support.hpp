@@ -36,8 +36,9 @@ inline void require_same_hits(const Hierarchy& h, const Hierarchy& brute, std::s
             ok = std::fabs(want[i].t - got[i].t) <= tol;
         }
         if (!ok) {
+            const std::string name(h.name());
             std::fprintf(stderr, "%s: %s differs from brute force on ray %zu: want %d t %.9g, got %d t %.9g\n", what,
-                         h.name().c_str(), i, want[i].prim, double(want[i].t), got[i].prim, double(got[i].t));
+                         name.c_str(), i, want[i].prim, double(want[i].t), got[i].prim, double(got[i].t));
             std::abort();
         }
     }
