@@ -44,13 +44,24 @@ struct BuildArgs {
     std::vector<std::string> set;
 };
 void add_build_args(CLI::App* cmd, BuildArgs& a);
-/// Builds with a note on a terminal while it runs.
+/// Warns on stderr (unless quiet) of every bound that stopped a build (StructureStats::limits).
+void print_limits(const StructureStats& s, const Common& common);
+/// Builds with a note on a terminal while it runs, then warns of the bounds that stopped it
+/// (for a lazily built hierarchy, call print_limits after tracing).
 std::unique_ptr<Hierarchy> build(const Scene& scene, const BuildArgs& a, const Common& common);
 
 /// --rays, --size, --count, --seed into `spec`.
 void add_ray_args(CLI::App* cmd, RaySpec& spec);
 /// --camera and --light into `view`.
 void add_view_args(CLI::App* cmd, ViewSpec& view);
+
+/// Refuses, before any long work, an output path that is a directory or lies in a directory
+/// that does not exist (InputError naming the path). `-` is standard output.
+void check_output_path(const std::string& path, const std::string& what);
+
+/// --threads clamped to the threads the machine runs at once (a warning on stderr when it is
+/// clamped, unless quiet); 0 stays 0 (all cores).
+int checked_threads(int requested, bool quiet);
 
 /// Parses --query.
 Query parse_query(const std::string& q);

@@ -2,6 +2,7 @@
 #include "cli.hpp"
 
 #include <cstdio>
+#include <filesystem>
 #include <unistd.h>
 
 namespace rtcost::cli {
@@ -26,7 +27,9 @@ void add_ray_args(CLI::App* cmd, RaySpec& spec) {
     cmd->add_option("-r,--rays", spec.name, "rays: a distribution (" + names + ") or a ray file (8 float32 per ray)")
         ->capture_default_str();
     cmd->add_option("--size", spec.size, "image size WxH for camera-based rays (default: the scene's)");
-    cmd->add_option("--count", spec.count, "number of rays for lines and random")->capture_default_str();
+    cmd->add_option("--count", spec.count, "number of rays for lines and random")
+        ->check(CLI::Range(std::size_t{1}, static_cast<std::size_t>(kMaxRays)))
+        ->capture_default_str();
     cmd->add_option("--seed", spec.seed, "seed for random distributions")->capture_default_str();
     add_view_args(cmd, spec.view);
 }
@@ -85,6 +88,11 @@ std::string hierarchy_footer() {
     return "Hierarchies: " + names + ".\n`rtcost list` prints each one's parameters with their defaults.";
 }
 
+void print_limits(const StructureStats& s, const Common& common) {
+    if (common.quiet) return;  // with --json too: stderr is not the JSON
+    for (const std::string& l : s.limits) fmt::print(stderr, "rtcost: warning: {}\n", l);
+}
+
 void add_build_args(CLI::App* cmd, BuildArgs& a) {
     cmd->add_option("SCENE", a.scene, "scene file (.nff, or any mesh assimp reads) or builtin:NAME[:level]")
         ->required();
@@ -100,7 +108,34 @@ std::unique_ptr<Hierarchy> build(const Scene& scene, const BuildArgs& a, const C
     std::fflush(stderr);
     auto h = build_hierarchy(scene, a.hierarchy, a.set);
     if (tty) fmt::print(stderr, "\r\033[K");
+    if (!h->lazy()) print_limits(h->structure(), common);
     return h;
+}
+
+}  // namespace rtcost::cli
+
+namespace rtcost::cli {
+
+void check_output_path(const std::string& path, const std::string& what) {
+    namespace fs = std::filesystem;
+    if (path.empty()) throw InputError(what, 0, "empty output path");
+    if (path == "-") return;
+    std::error_code ec;
+    if (fs::is_directory(path, ec)) throw InputError(path, 0, "is a directory; give a file name for the output");
+    fs::path parent = fs::path(path).parent_path();
+    if (!parent.empty() && !fs::is_directory(parent, ec))
+        throw InputError(path, 0, fmt::format("directory '{}' does not exist", parent.string()));
+}
+
+int checked_threads(int requested, bool quiet) {
+    const int available = default_threads();
+    if (requested > available) {
+        if (!quiet)
+            fmt::print(stderr, "rtcost: warning: --threads {}: the machine runs {} at once; using {}\n", requested,
+                       available, available);
+        return available;
+    }
+    return requested;
 }
 
 }  // namespace rtcost::cli

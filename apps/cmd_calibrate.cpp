@@ -1,7 +1,11 @@
 // `rtcost calibrate`: fit nanoseconds per operation kind to measured single-thread times.
 #include <algorithm>
+#include <filesystem>
+#include <fstream>
 #include <iostream>
+#include <iterator>
 #include <map>
+#include <unistd.h>
 
 #include "cli.hpp"
 #include "rtcost/evaluate.hpp"
@@ -40,6 +44,7 @@ double spearman(const std::vector<double>& x, const std::vector<double>& y) {
 
 int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     const std::vector<HierarchyRequest> names = parse_hierarchy_list(a.hierarchies, 0);
+    check_output_path(a.out, "--out");
     std::vector<CalibrationSample> samples, held;
     std::vector<std::string> held_scene;
     const std::size_t total = (a.scenes.size() + a.held_out.size()) * names.size();
@@ -71,7 +76,19 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     for (const std::string& spec : a.held_out) measure(spec, held, &held_scene);
     progress.finish();
     Calibration c = calibrate(samples);
-    write_costs(a.out, c, samples);
+    // write_costs renames its own temporary over the path, which would replace a device or a
+    // link; it writes to a private temporary here, copied onto the output by write_file_atomic.
+    {
+        namespace fs = std::filesystem;
+        const fs::path tmp = fs::temp_directory_path() / fmt::format("rtcost-costs-{}.json", ::getpid());
+        write_costs(tmp.string(), c, samples);
+        std::ifstream in(tmp, std::ios::binary);
+        std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        in.close();
+        std::error_code ec;
+        fs::remove(tmp, ec);
+        write_file_atomic(a.out, bytes);
+    }
     // Held-out scenes: predicted time from the fitted costs against measured time, and per
     // scene the rank agreement of the hierarchies by predicted and by measured time.
     std::vector<double> held_pred;

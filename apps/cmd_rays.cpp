@@ -18,13 +18,14 @@ struct RaysArgs {
 };
 
 int cmd_rays(const RaysArgs& a, const Common& common) {
+    if (!a.out.empty()) check_output_path(a.out, "--out");
     Scene scene = load(a.scene, common, a.spec.view);
     auto start = std::chrono::steady_clock::now();
     RaySet set;
     if (is_tree_distribution(a.spec.name)) {
         // The number of rows is known once the generator starts (it depends on --size).
         std::optional<Progress> progress;
-        set = make_tree_rays(scene, a.spec, a.threads, [&](std::size_t done, std::size_t rows) {
+        set = make_tree_rays(scene, a.spec, checked_threads(a.threads, common.quiet || common.json), [&](std::size_t done, std::size_t rows) {
             if (!progress) progress.emplace(fmt::format("rays {} (rows)", a.spec.name), rows, common.quiet || common.json);
             progress->update(done);
         });

@@ -19,6 +19,7 @@ struct TraceArgs {
 };
 
 int cmd_trace(const TraceArgs& a, const Common& common) {
+    if (!a.hits_out.empty()) check_output_path(a.hits_out, "--hits");
     Scene scene = load(a.b.scene, common, a.rays.view);
     RaySet rays = make_rays(scene, a.rays);
     auto h = build(scene, a.b, common);
@@ -26,7 +27,7 @@ int cmd_trace(const TraceArgs& a, const Common& common) {
 
     TraceOptions opt;
     opt.query = parse_query(a.query);
-    opt.threads = a.threads;
+    opt.threads = checked_threads(a.threads, common.quiet || common.json);
     const Query occlusion = parse_query(a.shadow);
     TraceResult timed;
     {
@@ -42,6 +43,11 @@ int cmd_trace(const TraceArgs& a, const Common& common) {
         opt.progress = [&](std::size_t done) { progress.update(done); };
         opt.count = true;
         counted = trace_ray_set(*h, rays, opt, occlusion);
+    }
+    if (h->lazy()) {
+        // A lazily built structure meets its bounds while the rays grow it.
+        s.limits = h->structure().limits;
+        print_limits(s, common);
     }
     if (!a.hits_out.empty()) write_hits(a.hits_out, timed.hits);
 

@@ -13,6 +13,7 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   libcairo2-dev fonts-dejavu-core    # heat maps: legends drawn with a real font
   chromium                           # the report's test in a headless browser
+  clang libclang-rt-14-dev llvm      # sanitizer builds, libFuzzer, symbolised reports
 )
 # npm installs the report's plotting library (Vega-Lite) and the browser test's driver; a machine
 # with Node.js from elsewhere (e.g. NodeSource) keeps it.

@@ -39,9 +39,14 @@ struct BuiltinInfo {
 };
 std::vector<BuiltinInfo> builtin_scenes();
 
+/// Range of the largest component of a ray file's direction: outside it the reciprocals the
+/// traversals use, or the hit distances, leave float's range.
+inline constexpr float kMinDirection = 1e-12f, kMaxDirection = 1e12f;
+
 /// One record of a ray file: 8 little-endian float32, `ox oy oz dx dy dz tmin tmax`.
 /// Reads a whole ray file; throws InputError when its size is not a multiple of 32 bytes, or a
-/// record has a NaN, an infinite origin or direction, a zero direction, or tmin > tmax.
+/// record has a NaN, an infinite origin or direction, a zero direction, tmin > tmax, a negative
+/// tmin, an origin beyond kMaxCoordinate, or a direction outside [kMinDirection, kMaxDirection].
 std::vector<Ray> read_rays(const std::string& path);
 /// Writes rays atomically (to a temporary file renamed into place).
 void write_rays(const std::string& path, std::span<const Ray> rays);
@@ -52,7 +57,9 @@ void write_hits(const std::string& path, std::span<const Hit> hits);
 std::vector<Hit> read_hits(const std::string& path);
 
 /// Writes `bytes` to `path` atomically: a temporary file in the same directory, renamed into
-/// place once complete, so a failure never leaves a half-written output. Throws InputError.
+/// place once complete, so a failure never leaves a half-written output. Only a regular file (or
+/// a new path) is replaced so; a device, a pipe or `-` (stdout) is written in place, a symbolic
+/// link is followed to the file it names, and a directory is refused. Throws InputError.
 void write_file_atomic(const std::string& path, std::string_view bytes);
 
 }  // namespace rtcost

@@ -107,9 +107,12 @@ struct RayInv {
 inline float box_entry(const Box3& b, const Vec3& o, const Vec3& inv, float tmin, float tmax) {
     float t0 = tmin, t1 = tmax;
     for (int a = 0; a < 3; ++a) {
-        float tn = (b.lo[a] - o[a]) * inv[a];
-        float tf = (b.hi[a] - o[a]) * inv[a];
-        if (tn > tf) std::swap(tn, tf);
+        // Entry and exit faces by the reciprocal's sign, not by comparing the two values: with
+        // the origin in a face's plane one of them is NaN (0 * inf), and a compare-and-swap would
+        // leave the infinite one in the wrong slot for a direction of -0 (the ray rejected).
+        const bool neg = std::signbit(inv[a]);
+        float tn = ((neg ? b.hi[a] : b.lo[a]) - o[a]) * inv[a];
+        float tf = ((neg ? b.lo[a] : b.hi[a]) - o[a]) * inv[a];
         tf *= 1.0000004f;  // 1 + 2*gamma(3): conservative against rounding
         t0 = tn > t0 ? tn : t0;
         t1 = tf < t1 ? tf : t1;

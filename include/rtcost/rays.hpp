@@ -80,7 +80,10 @@ std::vector<std::string> distribution_names();
 /// Builds the ray set `spec` names over `scene`; throws InputError for a bad spec or file.
 RaySet make_rays(const Scene& scene, const RaySpec& spec);
 
-/// Parses "WxH" (e.g. "512x512"); throws InputError naming `what` otherwise.
+/// Most rays one ray set may hold (--count, --size W*H): about 60 bytes each with the hits.
+inline constexpr std::uint64_t kMaxRays = 50'000'000;
+
+/// Parses "WxH" (e.g. "512x512") with W*H <= kMaxRays; throws InputError naming `what` otherwise.
 void parse_size(const std::string& text, const std::string& what, int& width, int& height);
 
 }  // namespace rtcost

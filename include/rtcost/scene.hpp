@@ -48,6 +48,23 @@ struct PrimSummary {
     PrimKind kind = PrimKind::Triangle;
 };
 
+/// Largest coordinate magnitude of a scene (vertices, sphere and cone extents, camera, lights)
+/// and of a ray origin. Beyond it the float arithmetic of the box tests, the surface-area costs
+/// and Embree's reference no longer hold; loading refuses it (InputError) instead of answering
+/// wrongly.
+inline constexpr float kMaxCoordinate = 1e12f;
+/// Smallest extent (largest side of the bounds) of a whole scene; below it squared lengths
+/// underflow in float. Loading refuses it.
+inline constexpr float kMinSceneExtent = 1e-12f;
+
+class Scene;
+/// Checks a finalized scene against the limits above and that every primitive has finite,
+/// non-empty bounds; throws InputError(scene.name, 0, problem) otherwise, or for an empty scene
+/// (naming the warnings about what was skipped).
+void check_scene(const Scene& scene);
+/// "scene has no primitives", with how many were skipped and the first reason, when any were.
+std::string no_primitives_message(const std::vector<std::string>& warnings);
+
 class Scene {
 public:
     std::string name;  ///< file path or builtin spec it came from
@@ -76,8 +93,12 @@ public:
     std::uint32_t add(const Triangle& t, std::uint32_t material);
     std::uint32_t add(const Sphere& s, std::uint32_t material);
     std::uint32_t add(const Cone& c, std::uint32_t material);
-    /// Adds a polygon over `verts`; returns false (adding nothing) when it is degenerate.
-    bool add_polygon(std::span<const Vec3> verts, std::uint32_t material, std::uint32_t* id = nullptr);
+    /// Adds a polygon over `verts`; returns false (adding nothing) when it is degenerate. A
+    /// polygon of more than three vertices that is not planar (a vertex off its plane by more
+    /// than 1e-6 of its size) is flattened onto the plane of its normal, keeping its outline in
+    /// the projection the intersection uses; `flattened` (if given) says so.
+    bool add_polygon(std::span<const Vec3> verts, std::uint32_t material, std::uint32_t* id = nullptr,
+                     bool* flattened = nullptr);
 
     /// Bounds and area of primitive `id` (from summaries() once finalized).
     Box3 prim_bounds(std::uint32_t id) const;

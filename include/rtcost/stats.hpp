@@ -9,6 +9,8 @@
 
 #include <array>
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "rtcost/primitive.hpp"
 
@@ -88,6 +90,9 @@ struct StructureStats {
     int depth = 0;                  ///< deepest leaf (root at depth 0)
     std::uint64_t bytes = 0;        ///< memory of the structure itself (not the scene)
     double seconds = 0;             ///< build time
+    /// Bounds on time or memory that stopped the build short of what its parameters asked
+    /// ("grid: resolution 46x46x46 reduced to ..."); empty when none did.
+    std::vector<std::string> limits;
 };
 
 }  // namespace rtcost

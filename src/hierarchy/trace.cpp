@@ -1,5 +1,6 @@
 #include "rtcost/trace.hpp"
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <ctime>
@@ -26,7 +27,8 @@ double process_cpu_seconds() {
 TraceResult trace_rays(const Hierarchy& h, std::span<const Ray> rays, const TraceOptions& opt) {
     TraceResult res;
     res.hits.assign(rays.size(), Hit{});
-    res.threads = opt.threads > 0 ? opt.threads : default_threads();
+    // More threads than the machine runs at once would be reported but not run.
+    res.threads = opt.threads > 0 ? std::min(opt.threads, default_threads()) : default_threads();
     tbb::task_arena arena(res.threads);
     tbb::enumerable_thread_specific<RayCounters> local;
     std::atomic<std::size_t> done{0};
@@ -80,7 +82,8 @@ TraceResult trace_rays(const Hierarchy& h, std::span<const Ray> rays, const Trac
 TraceResult trace_ray_set(const Hierarchy& h, const RaySet& set, const TraceOptions& opt, Query occlusion) {
     TraceResult res;
     res.hits.assign(set.rays.size(), Hit{});
-    res.threads = opt.threads > 0 ? opt.threads : default_threads();
+    // More threads than the machine runs at once would be reported but not run.
+    res.threads = opt.threads > 0 ? std::min(opt.threads, default_threads()) : default_threads();
     // One batch per kind, so each batch runs one query and its counters stay apart.
     std::array<std::vector<std::size_t>, kRayKinds> index;
     for (std::size_t i = 0; i < set.rays.size(); ++i) index[static_cast<int>(set.kinds[i])].push_back(i);

@@ -47,6 +47,7 @@ Scene load_scene(std::string_view spec) {
         s = has_nff_extension(path) ? read_nff_file(path) : read_mesh(path);
     }
     s.name = std::string(spec);
+    check_scene(s);
     return s;
 }
 

@@ -10,6 +10,7 @@
 #include <assimp/scene.h>
 #include <fmt/format.h>
 
+#include "mesh_precheck.hpp"
 #include "rtcost/io.hpp"
 
 namespace rtcost {
@@ -56,10 +57,12 @@ Scene read_mesh(const std::string& path) {
     if (!std::filesystem::exists(path, ec)) throw InputError(path, 0, "no such file");
     if (std::filesystem::is_directory(path, ec)) throw InputError(path, 0, "is a directory");
 
+    precheck_mesh(path);
     Assimp::Importer importer;
     const aiScene* in = importer.ReadFile(path, aiProcess_ValidateDataStructure);
     if (!in) {
         std::string err = importer.GetErrorString();
+        if (err.size() > 200) err = err.substr(0, 200) + "...";
         throw InputError(path, 0, err.empty() ? "cannot open file" : err);
     }
     if (in->mFlags & AI_SCENE_FLAGS_INCOMPLETE) 
@@ -112,7 +115,7 @@ Scene read_mesh(const std::string& path) {
         scene.warnings.push_back(fmt::format("{}: {} point or line faces skipped (not triangles)", path, not_triangles));
     if (degenerate > 0)
         scene.warnings.push_back(fmt::format("{}: {} degenerate triangles skipped (zero area)", path, degenerate));
-    if (scene.empty()) throw InputError(path, 0, "scene has no primitives");
+    if (scene.empty()) throw InputError(path, 0, no_primitives_message(scene.warnings));
 
     // Positional lights (point and spot); directional and ambient ones have no position.
     for (unsigned li = 0; li < in->mNumLights; ++li) {

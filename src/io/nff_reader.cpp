@@ -4,6 +4,7 @@
 // real files put the two cone circles either on one line or on two, and the grammar never
 // needs line ends except for the optional light colour.
 
+#include <algorithm>
 #include <charconv>
 #include <cmath>
 #include <cstdio>
@@ -72,6 +73,13 @@ private:
     int peek_line_end_ = 1;
 };
 
+// A token as error messages show it: at most 40 characters (a runaway token can be megabytes).
+std::string shown(std::string_view t) {
+    constexpr std::size_t kMax = 40;
+    if (t.size() <= kMax) return std::string(t);
+    return fmt::format("{}... ({} characters)", t.substr(0, kMax), t.size());
+}
+
 bool is_entity(std::string_view t) {
     return t == "v" || t == "b" || t == "l" || t == "f" || t == "c" || t == "s" || t == "p" || t == "pp";
 }
@@ -100,10 +108,14 @@ public:
             else if (k == "s") sphere();
             else if (k == "p") polygon(false);
             else if (k == "pp") polygon(true);
-            else if (looks_numeric(k)) fail(t.line, fmt::format("unexpected number '{}' where an entity belongs", k));
-            else fail(t.line, fmt::format("unknown entity '{}'", k));
+            else if (looks_numeric(k)) fail(t.line, fmt::format("unexpected number '{}' where an entity belongs", shown(k)));
+            else fail(t.line, fmt::format("unknown entity '{}'", shown(k)));
         }
-        if (scene_.empty()) throw InputError(name_, 0, "scene has no primitives");
+        if (flattened_ > 0)
+            scene_.warnings.push_back(fmt::format("{}: {} non-planar polygon{} flattened onto the plane of the first "
+                                                  "three vertices (first at line {})",
+                                                  name_, flattened_, flattened_ == 1 ? "" : "s", first_flattened_));
+        if (scene_.empty()) throw InputError(name_, 0, no_primitives_message(scene_.warnings));
         scene_.finalize();
         return std::move(scene_);
     }
@@ -132,9 +144,9 @@ private:
             double d = 0;
             auto [dend, dec] = std::from_chars(s.data(), last, d);
             if (dec == std::errc() && dend == last && std::isfinite(static_cast<float>(d))) return static_cast<float>(d);
-            fail(t.line, fmt::format("number out of range: '{}'", t.text));
+            fail(t.line, fmt::format("number out of range: '{}'", shown(t.text)));
         }
-        fail(t.line, fmt::format("expected a number, got '{}'", t.text));
+        fail(t.line, fmt::format("expected a number, got '{}'", shown(t.text)));
     }
 
     long integer(const char* what) {
@@ -143,7 +155,7 @@ private:
         long v = 0;
         auto [end, ec] = std::from_chars(t.text.data(), t.text.data() + t.text.size(), v);
         if (ec != std::errc() || end != t.text.data() + t.text.size())
-            fail(t.line, fmt::format("expected an integer, got '{}'", t.text));
+            fail(t.line, fmt::format("expected an integer, got '{}'", shown(t.text)));
         return v;
     }
 
@@ -158,6 +170,16 @@ private:
     // Reports at the line of the last number read: the entity's line except for two-line cones.
     void require_finite(bool ok, const char* what) const {
         if (!ok) fail(num_line_, fmt::format("{} is not finite", what));
+    }
+
+    // Coordinates beyond kMaxCoordinate are refused where they are read (check_scene would
+    // refuse them too, without the line).
+    void require_in_range(Vec3 v, float pad, const char* what) const {
+        const float m = std::max({std::fabs(v.x), std::fabs(v.y), std::fabs(v.z)}) + pad;
+        if (m > kMaxCoordinate)
+            fail(num_line_, fmt::format("{} reaches {:g}, beyond +-{:g}, the largest coordinate the float "
+                                        "intersection and box tests handle (scale the scene down)",
+                                        what, m, kMaxCoordinate));
     }
 
     std::uint32_t current_material() {
@@ -183,10 +205,12 @@ private:
             if (k == "from") {
                 cam.from = vec3("viewpoint");
                 require_finite(is_finite(cam.from), "viewpoint 'from'");
+                require_in_range(cam.from, 0, "viewpoint 'from'");
                 from = true;
             } else if (k == "at") {
                 cam.at = vec3("viewpoint");
                 require_finite(is_finite(cam.at), "viewpoint 'at'");
+                require_in_range(cam.at, 0, "viewpoint 'at'");
                 at = true;
             } else if (k == "up") {
                 cam.up = vec3("viewpoint");
@@ -227,6 +251,7 @@ private:
         Light l;
         l.position = vec3("light");
         require_finite(is_finite(l.position), "light position");
+        require_in_range(l.position, 0, "light position");
         // The colour is optional and, when present, on the light's own line.
         Token t = tok_.peek();
         if (t.line == line && looks_numeric(t.text)) {
@@ -258,6 +283,7 @@ private:
         require_finite(is_finite(s.center), "sphere centre");
         require_finite(std::isfinite(r), "sphere radius");
         s.radius = std::fabs(r);  // negative: inside visible; hits are geometric either way
+        require_in_range(s.center, s.radius, "sphere");
         std::uint32_t m = current_material();
         if (s.radius == 0) return degenerate("sphere", "zero radius");
         scene_.add(s, m);
@@ -275,6 +301,8 @@ private:
         require_finite(std::isfinite(ar), "cone apex radius");
         c.base_radius = std::fabs(br);  // both negative: inside visible; hits are geometric
         c.apex_radius = std::fabs(ar);
+        require_in_range(c.base, c.base_radius, "cone");
+        require_in_range(c.apex, c.apex_radius, "cone");
         std::uint32_t m = current_material();
         if (c.base == c.apex) return degenerate("cone", "coincident ends");
         if (c.base_radius == 0 && c.apex_radius == 0) return degenerate("cone", "zero radii");
@@ -295,18 +323,22 @@ private:
                 if (t.text.empty())
                     fail(entity_line_, fmt::format("file ends inside {}: expected {} vertices, got {}", kind, n, i));
                 if (is_entity(t.text))
-                    fail(t.line, fmt::format("{} ends early: expected {} vertices, got {} before '{}'", kind, n, i, t.text));
+                    fail(t.line, fmt::format("{} ends early: expected {} vertices, got {} before '{}'", kind, n, i, shown(t.text)));
                 if (k == 0) line = t.line;
                 v[k] = to_float(t);
             }
             Vec3 p{v[0], v[1], v[2]};
             if (!is_finite(p)) fail(line, fmt::format("{} vertex {} is not finite", kind, i + 1));
+            num_line_ = line;
+            require_in_range(p, 0, kind);
             if (patch && !is_finite(Vec3{v[3], v[4], v[5]}))
                 fail(line, fmt::format("{} normal {} is not finite", kind, i + 1));
             verts_.push_back(p);  // patch normals are checked but not kept: hits are geometric
         }
         std::uint32_t m = current_material();
-        if (!scene_.add_polygon(verts_, m)) degenerate(kind, degenerate_reason());
+        bool flat = false;
+        if (!scene_.add_polygon(verts_, m, nullptr, &flat)) degenerate(kind, degenerate_reason());
+        else if (flat && flattened_++ == 0) first_flattened_ = entity_line_;
     }
 
     // Why add_polygon refused the polygon in verts_; only computed on that rare path.
@@ -335,12 +367,15 @@ private:
     int material_ = -1;
     int entity_line_ = 0;
     int num_line_ = 0;
+    int flattened_ = 0, first_flattened_ = 0;
     std::vector<Vec3> verts_;
 };
 
 }  // namespace
 
 Scene read_nff(std::string_view text, const std::string& name) {
+    // A UTF-8 byte-order mark, as some editors write, is not part of the first entity.
+    if (text.starts_with("\xEF\xBB\xBF")) text.remove_prefix(3);
     Scene s = NffParser(text, name).parse();
     s.name = name;
     return s;

@@ -1,7 +1,9 @@
 // Binary ray and hit files (see docs: 8 little-endian float32 per ray; int32 id + float32 t per
 // hit) and atomic output. The formats are fixed-size records, so no serialisation library is
 // needed; the code assumes a little-endian host, which it checks at compile time.
+#include <algorithm>
 #include <bit>
+#include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -9,6 +11,8 @@
 #include <fstream>
 #include <iterator>
 #include <unistd.h>
+
+#include <fmt/format.h>
 
 #include "rtcost/io.hpp"
 
@@ -18,6 +22,8 @@ namespace rtcost {
 namespace {
 
 std::string read_all(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw InputError(path, 0, "is a directory, not a file");
     std::ifstream in(path, std::ios::binary);
     if (!in) {
         throw InputError(path, 0, std::filesystem::exists(path) ? "cannot open file" : "no such file");
@@ -25,6 +31,17 @@ std::string read_all(const std::string& path) {
     std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     if (in.bad()) throw InputError(path, 0, "read error");
     return bytes;
+}
+
+/// Writes to an existing non-regular file (device, pipe, stdout) without replacing it.
+void write_in_place(const std::string& path, const std::string& target, std::string_view bytes) {
+    std::FILE* f = std::fopen(target.c_str(), "wb");
+    if (!f) throw InputError(path, 0, "cannot open for writing (" + std::string(std::strerror(errno)) + ")");
+    const std::size_t put = std::fwrite(bytes.data(), 1, bytes.size(), f);
+    const bool ok = put == bytes.size() && std::fflush(f) == 0;
+    const int err = errno;
+    std::fclose(f);
+    if (!ok) throw InputError(path, 0, "write failed (" + std::string(std::strerror(err)) + ")");
 }
 
 }  // namespace
@@ -55,32 +72,53 @@ std::vector<Ray> read_rays(const std::string& path) {
         if (std::isnan(r.tmin) || std::isnan(r.tmax)) bad("tmin or tmax is NaN");
         if (r.tmin == kInf) bad("tmin is +inf");
         if (r.tmin > r.tmax) bad("tmin > tmax");
+        // Traversals clip to t >= 0 (a box's widened exit shrinks a negative interval) and Embree
+        // asserts on it: segments behind the origin are not traced.
+        if (r.tmin < 0) bad("tmin " + fmt::format("{:g}", r.tmin) + " is negative (tmin must be >= 0)");
+        const float om = std::max({std::fabs(r.o.x), std::fabs(r.o.y), std::fabs(r.o.z)});
+        if (om > kMaxCoordinate)
+            bad(fmt::format("origin reaches {:g}, beyond +-{:g}, the largest coordinate rtcost traces exactly", om,
+                            kMaxCoordinate));
+        const float dm = std::max({std::fabs(r.d.x), std::fabs(r.d.y), std::fabs(r.d.z)});
+        if (dm < kMinDirection || dm > kMaxDirection)
+            bad(fmt::format("direction's largest component {:g} is outside [{:g}, {:g}] (reciprocals and t would "
+                            "leave float's range; scale the direction)",
+                            dm, kMinDirection, kMaxDirection));
     }
     return rays;
 }
 
 void write_file_atomic(const std::string& path, std::string_view bytes) {
     namespace fs = std::filesystem;
-    fs::path target(path);
+    std::error_code ec;
+    if (path.empty()) throw InputError("output", 0, "empty output path");
+    // `-` is standard output, written in place.
+    if (path == "-") return write_in_place(path, "/dev/stdout", bytes);
+    // Through a symbolic link: the file it points to is what the user named.
+    fs::path target = fs::weakly_canonical(fs::path(path), ec);
+    if (ec) target = fs::path(path);
+    const fs::file_status st = fs::status(target, ec);
+    if (fs::is_directory(st)) throw InputError(path, 0, "is a directory; give a file name for the output");
+    // A device, a pipe or a socket is written in place: renaming over it would replace it.
+    if (fs::exists(st) && !fs::is_regular_file(st)) return write_in_place(path, target.string(), bytes);
     fs::path tmp = target;
     tmp += ".tmp." + std::to_string(::getpid());
     {
         std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw InputError(path, 0, "cannot open for writing");
+        if (!out) throw InputError(path, 0, "cannot open for writing (" + std::string(std::strerror(errno)) + ")");
         out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
         out.flush();
         if (!out) {
             out.close();
-            std::error_code ec;
             fs::remove(tmp, ec);
             throw InputError(path, 0, "write failed (disk full?)");
         }
     }
-    std::error_code ec;
     fs::rename(tmp, target, ec);
     if (ec) {
+        const std::string why = ec.message();
         fs::remove(tmp, ec);
-        throw InputError(path, 0, "cannot move output into place: " + ec.message());
+        throw InputError(path, 0, "cannot move output into place: " + why);
     }
 }
 

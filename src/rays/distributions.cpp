@@ -2,15 +2,26 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
+
 #include "rtcost/error.hpp"
 #include "rtcost/rays.hpp"
 #include "util/rng.hpp"
 
 namespace rtcost {
+namespace {
+
+Vec3 normalize_double(Vec3 v) {
+    const double l = std::sqrt(double(v.x) * v.x + double(v.y) * v.y + double(v.z) * v.z);
+    return {static_cast<float>(v.x / l), static_cast<float>(v.y / l), static_cast<float>(v.z / l)};
+}
+
+}  // namespace
 
 std::vector<Ray> camera_rays(const Camera& cam, int width, int height) {
-    Vec3 fwd = normalize(cam.at - cam.from);
-    Vec3 right = normalize(cross(fwd, cam.up));
+    // Normalised in double: a short view vector or up vector underflows in float to NaN rays.
+    Vec3 fwd = normalize_double(cam.at - cam.from);
+    Vec3 right = normalize_double(cross(fwd, normalize_double(cam.up)));
     Vec3 up = cross(right, fwd);
     // NFF: the angle spans from the centre of the top pixel row to the centre of the bottom one.
     double half = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0);
@@ -37,8 +48,12 @@ std::vector<Ray> line_rays(const Box3& box, std::size_t n, std::uint64_t seed) {
     std::vector<Ray> rays;
     rays.reserve(n);
     Vec3 c = box.center();
-    float radius = 0.5f * length(box.extent());
+    const Vec3 ext = box.extent();
+    float radius = static_cast<float>(0.5 * std::sqrt(double(ext.x) * ext.x + double(ext.y) * ext.y + double(ext.z) * ext.z));
+    // A point box (radius 0) gives every line through the point, accepted at once.
     const float margin = 1e-4f * radius;
+    constexpr int kMaxRejections = 1000000;
+    int rejected_in_a_row = 0;
     while (rays.size() < n) {
         Vec3 d = rng.direction();
         // Uniform point on the disc of the bounding sphere's projection, then keep it when the
@@ -53,12 +68,21 @@ std::vector<Ray> line_rays(const Box3& box, std::size_t n, std::uint64_t seed) {
         RayInv ri(Ray{o, d, -kInf, kInf});
         float t0 = -kInf, t1 = kInf;
         for (int k = 0; k < 3; ++k) {
-            float tn = (box.lo[k] - o[k]) * ri.inv[k], tf = (box.hi[k] - o[k]) * ri.inv[k];
-            if (tn > tf) std::swap(tn, tf);
+            float tn = ((ri.neg[k] ? box.hi[k] : box.lo[k]) - o[k]) * ri.inv[k];
+            float tf = ((ri.neg[k] ? box.lo[k] : box.hi[k]) - o[k]) * ri.inv[k];
             t0 = tn > t0 ? tn : t0;
             t1 = tf < t1 ? tf : t1;
         }
-        if (!(t0 < t1)) continue;
+        // A flat box (one axis-aligned triangle) has t0 == t1 on that axis: such a line still
+        // crosses it, so equality is accepted (strict rejection never accepted one, and hung).
+        if (!(t0 <= t1)) {
+            // The disc contains the box's projection, whose share of the disc has a positive
+            // lower bound for a box with any extent; no real box gets anywhere near this.
+            if (++rejected_in_a_row > kMaxRejections)
+                throw InputError("lines", 0, fmt::format("no line met the scene box {} times in a row", kMaxRejections));
+            continue;
+        }
+        rejected_in_a_row = 0;
         // The segment reaches a hair past the box on both ends, so that geometry lying exactly
         // on the box's faces (a ground polygon) is met whatever the rounding of the entry point.
         rays.push_back(Ray{o + d * (t0 - margin), d, 0, t1 - t0 + 2 * margin});
@@ -86,10 +110,14 @@ void parse_size(const std::string& text, const std::string& what, int& width, in
         auto [p, ec] = std::from_chars(s.data(), s.data() + s.size(), out);
         return ec == std::errc() && p == s.data() + s.size() && out > 0 && out <= 65536;
     };
+    const std::string shown = text.size() > 40 ? text.substr(0, 40) + "..." : text;
     if (x == std::string::npos || !num(std::string_view(text).substr(0, x), width) ||
         !num(std::string_view(text).substr(x + 1), height)) {
-        throw InputError(what, 0, "'" + text + "': expected WxH with 1 <= W, H <= 65536, e.g. 512x512");
+        throw InputError(what, 0, "'" + shown + "': expected WxH with 1 <= W, H <= 65536, e.g. 512x512");
     }
+    if (static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height) > kMaxRays)
+        throw InputError(what, 0, fmt::format("'{}' is {} rays; at most {} (about 60 bytes each)", shown,
+                                              static_cast<std::uint64_t>(width) * height, kMaxRays));
 }
 
 }  // namespace rtcost

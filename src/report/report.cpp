@@ -6,8 +6,10 @@
 namespace rtcost {
 
 nlohmann::json to_json(const StructureStats& s) {
-    return {{"N_IN", s.interior}, {"N_V", s.leaves},      {"N_EV", s.empty_leaves}, {"N_OIV", s.references},
-            {"depth", s.depth},   {"bytes", s.bytes},     {"seconds", s.seconds}};
+    nlohmann::json j = {{"N_IN", s.interior}, {"N_V", s.leaves},  {"N_EV", s.empty_leaves}, {"N_OIV", s.references},
+                        {"depth", s.depth},   {"bytes", s.bytes}, {"seconds", s.seconds}};
+    if (!s.limits.empty()) j["limits"] = s.limits;
+    return j;
 }
 
 nlohmann::json per_ray_json(const RayCounters& c) {

@@ -1,4 +1,5 @@
 // Exact ray intersection, bounds and area of the four primitive kinds.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -41,6 +42,13 @@ inline bool nearest(double t0, double t1, float tmin, float tmax, float& t) {
     return false;
 }
 
+/// Unit vector along `v`; +z when `v` is zero (a hit point rounded onto a tiny sphere's centre).
+Vec3 unit(D3 v) {
+    const double l = std::sqrt(dot(v, v));
+    if (!(l > 0) || !std::isfinite(l)) return {0, 0, 1};
+    return {static_cast<float>(v.x / l), static_cast<float>(v.y / l), static_cast<float>(v.z / l)};
+}
+
 /// Newell's normal: twice the vector area of a planar polygon, any shape.
 D3 newell(const Vec3* v, std::uint32_t n) {
     D3 s{0, 0, 0};
@@ -51,6 +59,18 @@ D3 newell(const Vec3* v, std::uint32_t n) {
         s.z += (a.x - b.x) * (a.y + b.y);
     }
     return s;
+}
+
+/// The end of the watertight test with the edge values in double: the sign test, the
+/// determinant and the hit distance.
+bool finish_in_double(double u, double v, double w, float az, float bz, float cz, const Ray& ray, float& t) {
+    if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return false;
+    const double det = u + v + w;
+    if (det == 0.0) return false;
+    const float tt = static_cast<float>((u * az + v * bz + w * cz) / det);
+    if (!(tt > ray.tmin && tt < ray.tmax)) return false;
+    t = tt;
+    return true;
 }
 
 }  // namespace
@@ -68,17 +88,31 @@ bool intersect(const Triangle& tri, const Ray& ray, float& t) {
     const float ax = a[kx] - sx * a[kz], ay = a[ky] - sy * a[kz];
     const float bx = b[kx] - sx * b[kz], by = b[ky] - sy * b[kz];
     const float cx = c[kx] - sx * c[kz], cy = c[ky] - sy * c[kz];
-    float u = cx * by - cy * bx, v = ax * cy - ay * cx, w = bx * ay - by * ax;
-    if (u == 0.0f || v == 0.0f || w == 0.0f) {
-        u = static_cast<float>(double(cx) * by - double(cy) * bx);
-        v = static_cast<float>(double(ax) * cy - double(ay) * cx);
-        w = static_cast<float>(double(bx) * ay - double(by) * ax);
+    const float u1 = cx * by, u2 = cy * bx, v1 = ax * cy, v2 = ay * cx, w1 = bx * ay, w2 = by * ax;
+    const float u = u1 - u2, v = v1 - v2, w = w1 - w2;
+    const float az = sz * a[kz], bz = sz * b[kz], cz = sz * c[kz];
+    // Each edge value is a difference of two rounded products: its sign is certain only when it
+    // exceeds their rounding (2^-24 of each); a long thin triangle's edge values cancel far
+    // below that and would report hits beside the triangle.
+    constexpr float kRound = 1.2e-7f;
+    if (std::fabs(u) <= kRound * (std::fabs(u1) + std::fabs(u2)) ||
+        std::fabs(v) <= kRound * (std::fabs(v1) + std::fabs(v2)) ||
+        std::fabs(w) <= kRound * (std::fabs(w1) + std::fabs(w2)) || !std::isfinite(u + v + w)) {
+        // An edge (nearly) through the ray, or products beyond float's range (huge or tiny
+        // triangles): the decision in double, where the products of the sheared float
+        // coordinates are exact and each difference is rounded once, so its sign is right.
+        const double du = double(cx) * by - double(cy) * bx, dv = double(ax) * cy - double(ay) * cx,
+                     dw = double(bx) * ay - double(by) * ax;
+        return finish_in_double(du, dv, dw, az, bz, cz, ray, t);
     }
     if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return false;
     const float det = u + v + w;
-    if (det == 0.0f) return false;
-    const float az = sz * a[kz], bz = sz * b[kz], cz = sz * c[kz];
     const float tt = (u * az + v * bz + w * cz) / det;
+    // t is the barycentric mean of az, bz, cz: with det and t both above 1e-18 the largest term
+    // is normal and the float sum is accurate. Below (tiny triangles, whose products are
+    // subnormal) or beyond float's range, the same t again in double.
+    if (!std::isfinite(tt) || !(std::fabs(det) >= 1e-18f) || !(std::fabs(tt) >= 1e-18f))
+        return finish_in_double(u, v, w, az, bz, cz, ray, t);
     if (!(tt > ray.tmin && tt < ray.tmax)) return false;
     t = tt;
     return true;
@@ -92,7 +126,8 @@ bool setup_polygon(Polygon& poly, std::span<const Vec3> pool) {
         if (!is_finite(v[i])) return false;
         box.extend(v[i]);
     }
-    const double scale = length(box.extent());
+    const Vec3 ext = box.extent();
+    const double scale = std::sqrt(double(ext.x) * ext.x + double(ext.y) * ext.y + double(ext.z) * ext.z);
     if (!(scale > 0)) return false;
     const D3 nw = newell(v, poly.count);
     const double nw_len = std::sqrt(dot(nw, nw));
@@ -181,8 +216,11 @@ bool intersect(const Cone& cone, const Ray& ray, float& t) {
     const double C = dot(r0, r0) - m * m;
     double roots[2];
     int n = 0;
-    const double scale = dot(d, d);
-    if (std::fabs(A) <= 1e-12 * scale) {
+    // A is a difference of two terms; for a flat cone (k large) each is far larger than |d|^2,
+    // and A's rounding is relative to them: a ray along a generator must not get a root from
+    // a rounded A of the wrong sign (a false hit on a cone of radius 2e9 and axis 1).
+    const double scale = dot(rd, rd) + k * k * ds * ds;
+    if (std::fabs(A) <= 1e-12 * std::max(scale, dot(d, d))) {
         if (B == 0) return false;  // parallel to a generator: the line lies on or off the surface
         roots[n++] = -C / (2 * B);
     } else {
@@ -228,11 +266,13 @@ Box3 bounds(const Sphere& s) {
 // bounds are rounded outwards by a relative epsilon so that float rounding never clips the
 // surface.
 Box3 bounds(const Cone& c) {
-    const Vec3 a = c.apex - c.base;
-    const float h = length(a);
+    // The axis in double: a short one (1e-30) must not underflow to an empty box while the
+    // intersection, in double, still meets the surface.
+    const D3 a = d3(c.apex) - d3(c.base);
+    const double h = std::sqrt(dot(a, a));
     Box3 b;
     if (!(h > 0)) return b;
-    const Vec3 w = a / h;
+    const Vec3 w{static_cast<float>(a.x / h), static_cast<float>(a.y / h), static_cast<float>(a.z / h)};
     const float rb = std::fabs(c.base_radius), ra = std::fabs(c.apex_radius);
     for (int pass = 0; pass < 2; ++pass) {
         const Vec3 centre = pass ? c.apex : c.base;
@@ -261,20 +301,26 @@ float area(const Cone& c) {
     return std::numbers::pi_v<float> * (rb + ra) * std::sqrt(h * h + (rb - ra) * (rb - ra));
 }
 
-Vec3 normal_at(const Triangle& tri) { return normalize(cross(tri.v1 - tri.v0, tri.v2 - tri.v0)); }
+// Normals in double: a tiny primitive's edge products underflow in float and would normalise
+// to NaN, which shading would pass on to every secondary ray.
+Vec3 normal_at(const Triangle& tri) {
+    const D3 e1 = d3(tri.v1) - d3(tri.v0), e2 = d3(tri.v2) - d3(tri.v0);
+    return unit({e1.y * e2.z - e1.z * e2.y, e1.z * e2.x - e1.x * e2.z, e1.x * e2.y - e1.y * e2.x});
+}
 
-Vec3 normal_at(const Sphere& s, Vec3 p) { return normalize(p - s.center); }
+Vec3 normal_at(const Sphere& s, Vec3 p) { return unit(d3(p) - d3(s.center)); }
 
 Vec3 normal_at(const Cone& c, Vec3 p) {
-    const Vec3 a = c.apex - c.base;
-    const float h = length(a);
-    const Vec3 w = a / h;
-    const Vec3 q = p - c.base;
-    const Vec3 radial = q - w * dot(q, w);
-    const float k = (std::fabs(c.apex_radius) - std::fabs(c.base_radius)) / h;
-    const float rl = length(radial);
-    if (!(rl > 0)) return w;  // the tip of a true cone
-    return normalize(radial / rl - w * k);
+    const D3 a = d3(c.apex) - d3(c.base);
+    const double h = std::sqrt(dot(a, a));
+    if (!(h > 0)) return {0, 0, 1};
+    const D3 w = a * (1.0 / h);
+    const D3 q = d3(p) - d3(c.base);
+    const D3 radial = q - w * dot(q, w);
+    const double k = (std::fabs(double(c.apex_radius)) - std::fabs(double(c.base_radius))) / h;
+    const double rl = std::sqrt(dot(radial, radial));
+    if (!(rl > 0)) return unit(w);  // the tip of a true cone
+    return unit(radial * (1.0 / rl) - w * k);
 }
 
 }  // namespace rtcost

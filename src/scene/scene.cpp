@@ -1,9 +1,79 @@
 #include "rtcost/scene.hpp"
 
+#include <algorithm>
 #include <cmath>
+
+#include <fmt/format.h>
+
+#include "rtcost/error.hpp"
 #include <numbers>
 
 namespace rtcost {
+
+namespace {
+
+// The intersection finds a polygon's hit on its plane and decides containment in the projection
+// that drops the normal's largest axis. A non-planar polygon's hits therefore lie off its
+// vertices' box, where no hierarchy looks. Moving each vertex along the dropped axis onto the
+// plane keeps the projected outline (what the inside test reads) and puts the hits inside the
+// vertices' box again. Returns false (changing nothing) when every vertex is within 1e-6 of the
+// polygon's size of its plane, which float rounding of planar input already reaches.
+bool flatten_polygon(const Polygon& p, std::vector<Vec3>& pool) {
+    Vec3* v = pool.data() + p.first;
+    Box3 box;
+    for (std::uint32_t i = 0; i < p.count; ++i) box.extend(v[i]);
+    const Vec3 e = box.extent();
+    const double size = std::sqrt(double(e.x) * e.x + double(e.y) * e.y + double(e.z) * e.z);
+    const double n[3] = {p.normal.x, p.normal.y, p.normal.z};
+    double off = 0;
+    for (std::uint32_t i = 0; i < p.count; ++i)
+        off = std::max(off, std::fabs(n[0] * v[i].x + n[1] * v[i].y + n[2] * v[i].z - double(p.plane_d)));
+    if (!(off > 1e-6 * size)) return false;
+    const int k = p.drop_axis, a = (k + 1) % 3, b = (k + 2) % 3;
+    for (std::uint32_t i = 0; i < p.count; ++i)
+        v[i][k] = static_cast<float>((double(p.plane_d) - n[a] * v[i][a] - n[b] * v[i][b]) / n[k]);
+    return true;
+}
+
+}  // namespace
+
+std::string no_primitives_message(const std::vector<std::string>& warnings) {
+    if (warnings.empty()) return "scene has no primitives";
+    return fmt::format("scene has no primitives ({} warning{} while reading; the first: {})", warnings.size(),
+                       warnings.size() == 1 ? "" : "s", warnings.front());
+}
+
+void check_scene(const Scene& s) {
+    if (s.empty()) throw InputError(s.name, 0, no_primitives_message(s.warnings));
+    const auto& sums = s.summaries();
+    auto beyond = [](Vec3 v) {
+        return std::fabs(v.x) > kMaxCoordinate || std::fabs(v.y) > kMaxCoordinate || std::fabs(v.z) > kMaxCoordinate;
+    };
+    for (std::uint32_t id = 0; id < sums.size(); ++id) {
+        const Box3& b = sums[id].bounds;
+        const std::string what = fmt::format("primitive {} ({})", id, prim_kind_name(sums[id].kind));
+        if (b.empty() || !is_finite(b.lo) || !is_finite(b.hi))
+            throw InputError(s.name, 0, what + " has no finite bounds");
+        if (beyond(b.lo) || beyond(b.hi))
+            throw InputError(s.name, 0,
+                             fmt::format("{} reaches {:g}, beyond +-{:g}, the largest coordinate the float "
+                                         "intersection and box tests handle (scale the scene down)",
+                                         what, std::max({std::fabs(b.lo.x), std::fabs(b.lo.y), std::fabs(b.lo.z),
+                                                         std::fabs(b.hi.x), std::fabs(b.hi.y), std::fabs(b.hi.z)}),
+                                         kMaxCoordinate));
+    }
+    const Vec3 e = s.bounds().extent();
+    const float extent = std::max({e.x, e.y, e.z});
+    if (!(extent >= kMinSceneExtent))
+        throw InputError(s.name, 0,
+                         fmt::format("the scene's extent {:g} is below {:g}, the smallest the float arithmetic "
+                                     "handles (scale the scene up)",
+                                     extent, kMinSceneExtent));
+    if (s.has_camera && (beyond(s.camera.from) || beyond(s.camera.at)))
+        throw InputError(s.name, 0, fmt::format("the viewpoint lies beyond +-{:g}", kMaxCoordinate));
+    for (const Light& l : s.lights)
+        if (beyond(l.position)) throw InputError(s.name, 0, fmt::format("a light lies beyond +-{:g}", kMaxCoordinate));
+}
 
 std::uint32_t Scene::add(const Triangle& t, std::uint32_t material) {
     prims.push_back({PrimKind::Triangle, static_cast<std::uint32_t>(triangles.size()), material});
@@ -23,7 +93,7 @@ std::uint32_t Scene::add(const Cone& c, std::uint32_t material) {
     return static_cast<std::uint32_t>(prims.size() - 1);
 }
 
-bool Scene::add_polygon(std::span<const Vec3> verts, std::uint32_t material, std::uint32_t* id) {
+bool Scene::add_polygon(std::span<const Vec3> verts, std::uint32_t material, std::uint32_t* id, bool* flattened) {
     Polygon p;
     p.first = static_cast<std::uint32_t>(polygon_vertices.size());
     p.count = static_cast<std::uint32_t>(verts.size());
@@ -31,6 +101,14 @@ bool Scene::add_polygon(std::span<const Vec3> verts, std::uint32_t material, std
     if (!setup_polygon(p, polygon_vertices)) {
         polygon_vertices.resize(p.first);
         return false;
+    }
+    if (flattened) *flattened = false;
+    if (p.count > 3 && flatten_polygon(p, polygon_vertices)) {
+        if (flattened) *flattened = true;
+        if (!setup_polygon(p, polygon_vertices)) {
+            polygon_vertices.resize(p.first);
+            return false;
+        }
     }
     prims.push_back({PrimKind::Polygon, static_cast<std::uint32_t>(polygons.size()), material});
     polygons.push_back(p);
@@ -99,7 +177,11 @@ void Scene::finalize() {
     if (materials.empty()) materials.push_back(Material{});
     if (empty()) return;
     Vec3 c = bounds_.center();
-    float radius = 0.5f * length(bounds_.extent());
+    // In double: a huge scene's squared extent overflows float, a tiny one's underflows. A scene
+    // without extent (not one that loading accepts) still gets a finite camera.
+    const Vec3 ext = bounds_.extent();
+    float radius = static_cast<float>(0.5 * std::sqrt(double(ext.x) * ext.x + double(ext.y) * ext.y + double(ext.z) * ext.z));
+    if (!(radius > 0) || !std::isfinite(radius)) radius = 1;
     if (!has_camera) {
         // A three-quarter view, the usual default of mesh viewers, from the side where the
         // bounding box shows most of itself, moved in until the box's corners just fit the field

@@ -1,4 +1,6 @@
 // `bsp`: the build, structure statistics, the model tree and the registration.
+#include <fmt/format.h>
+
 #include "bsp.hpp"
 #include "../common/tree_stats.hpp"
 
@@ -28,9 +30,11 @@ void Bsp::make_leaf(std::uint32_t node, const std::vector<std::uint32_t>& refs) 
 // Recursion depth is at most max_depth <= kMaxDepth.
 void Bsp::build(std::uint32_t node, const Box3& cell, int depth, std::vector<std::uint32_t>& refs,
                 const subdiv::Assigner& as) {
-    if (refs.size() <= static_cast<std::size_t>(o_.max_prims) || depth >= o_.max_depth ||
-        refs_.size() >= subdiv::kMaxRefs || nodes_.size() >= subdiv::kMaxNodes)
+    if (refs.size() <= static_cast<std::size_t>(o_.max_prims) || depth >= o_.max_depth) return make_leaf(node, refs);
+    if (refs_.size() >= subdiv::kMaxRefs || nodes_.size() >= subdiv::kMaxNodes) {
+        capped_ = true;
         return make_leaf(node, refs);
+    }
     // At the top of each block of three levels (X, Y, Z: the block ends in the cell's octants,
     // the very cells an octree node makes), the growth guard: the references straddle so much
     // that the block would hardly separate them.
@@ -64,6 +68,17 @@ void Bsp::build(std::uint32_t node, const Box3& cell, int depth, std::vector<std
 }
 
 StructureStats Bsp::compute_structure() const {
+    if (capped_) {
+        StructureStats s = compute_tree();
+        s.limits.push_back(fmt::format("bsp: subdivision stopped at {} references or {} nodes (the memory bound); "
+                                       "leaves below it hold more primitives than max_prims",
+                                       subdiv::kMaxRefs, subdiv::kMaxNodes));
+        return s;
+    }
+    return compute_tree();
+}
+
+StructureStats Bsp::compute_tree() const {
     StructureStats s = tree_structure(nodes_, [](const Node& n) { return n.leaf(); }, [](const Node&) { return 2u; });
     s.bytes = nodes_.size() * sizeof(Node) + refs_.size() * sizeof(std::uint32_t);
     return s;

@@ -76,6 +76,8 @@ public:
 
 protected:
     StructureStats compute_structure() const override;
+    StructureStats compute_tree() const;
+    bool capped_ = false;  ///< the references or nodes bound stopped the build somewhere
 
 private:
     void build(std::uint32_t node, const Box3& cell, int depth, std::vector<std::uint32_t>& refs,

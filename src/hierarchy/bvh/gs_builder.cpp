@@ -7,6 +7,7 @@
 // Cost, in units of area (probability of a ray meeting a box is proportional to its area):
 // every child box of an interior node N is tested when N is entered (area(N) each), and every
 // primitive of a leaf L when L is entered (area(L) each).
+#include <stdexcept>
 
 #include "bvh.hpp"
 #include "util/rng.hpp"
@@ -18,6 +19,7 @@ struct GNode {
     Box3 box;
     bool leaf = true;
     std::vector<std::uint32_t> items;  // children (interior) or primitive ids (leaf)
+    int height = 0;                    // levels below this node (0 for a leaf)
 };
 
 class GsTree {
@@ -36,11 +38,13 @@ public:
             if (fits(nodes_[0])) return add_to_leaf(0, id);
             // The root leaf is full: a new root pairs it with the new object.
             GNode old = std::move(nodes_[0]);
-            nodes_[0] = GNode{join(old.box, b), false, {}};
+            nodes_[0] = GNode{join(old.box, b), false, {}, 1};
             nodes_[0].items = {push(std::move(old)), push({b, true, {id}})};
             return;
         }
+        path_.clear();
         for (;;) {
+            path_.push_back(n);
             GNode& node = nodes_[n];
             node.box.extend(b);
             enum { kAddChild, kIntoLeaf, kPair, kDescend } what = kAddChild;
@@ -58,11 +62,13 @@ public:
                     double cost = g * (ch.items.size() + 1) - ch.box.area() * ch.items.size();
                     if (cost < best) { best = cost; what = kIntoLeaf; best_child = c; }
                 }
-                if (depth + 2 <= o_.max_depth) {
+                // Pairing pushes the child's whole subtree one level down: only where its deepest
+                // leaf stays within max_depth (the traversal's stack is sized by that bound).
+                if (depth + 2 + ch.height <= o_.max_depth) {
                     double cost = 2 * g + ab;  // new node's two child tests, the new leaf's test
                     if (cost < best) { best = cost; what = kPair; best_child = c; }
                 }
-                if (!ch.leaf) {
+                if (!ch.leaf && depth + 1 + ch.height <= o_.max_depth) {
                     // Growth of the child's children tests, plus the least the object can cost below.
                     double cost = (g - ch.box.area()) * ch.items.size() + ab;
                     if (cost < best) { best = cost; what = kDescend; best_child = c; }
@@ -76,21 +82,34 @@ public:
                     if (cost < best) { best = cost; what = kIntoLeaf; best_child = c; }
                 }
             }
+            if (best == kInf) {
+                // No leaf child either: descend into the cheapest child (its subtree is within the
+                // bound, since the tree is), or add one more child here when it is full of subtrees
+                // already at the bound.
+                for (std::uint32_t c : node.items) {
+                    double cost = join(nodes_[c].box, b).area() - nodes_[c].box.area();
+                    if (cost < best && depth + 1 < o_.max_depth) { best = cost; what = kDescend; best_child = c; }
+                }
+                // Unreachable: an interior node below max_depth - 1 has a child to descend into,
+                // and one at max_depth - 1 has only leaf children.
+                if (best == kInf) throw std::logic_error("bvh-gs: no insertion within max_depth");
+            }
             switch (what) {
                 case kAddChild: {
                     std::uint32_t leaf = push({b, true, {id}});
                     nodes_[n].items.push_back(leaf);
-                    return;
+                    return raise(1);
                 }
                 case kIntoLeaf: return add_to_leaf(best_child, id);
                 case kPair: {
                     // The new node takes the child's slot; the child and the new leaf go under it.
                     GNode old = std::move(nodes_[best_child]);
                     Box3 box = join(old.box, b);
+                    const int h = old.height + 1;
                     std::uint32_t moved = push(std::move(old));
                     std::uint32_t leaf = push({b, true, {id}});
-                    nodes_[best_child] = GNode{box, false, {moved, leaf}};
-                    return;
+                    nodes_[best_child] = GNode{box, false, {moved, leaf}, h};
+                    return raise(h + 1);
                 }
                 case kDescend:
                     n = best_child;
@@ -131,6 +150,13 @@ public:
     }
 
 private:
+    // The nodes on the insertion path (root first) are at least `h` above the changed level.
+    void raise(int h) {
+        for (std::size_t i = path_.size(); i-- > 0; ++h) {
+            if (nodes_[path_[i]].height >= h) break;
+            nodes_[path_[i]].height = h;
+        }
+    }
     bool fits(const GNode& leaf) const { return static_cast<int>(leaf.items.size()) < o_.max_prims; }
     void add_to_leaf(std::uint32_t leaf, std::uint32_t id) {
         nodes_[leaf].items.push_back(id);
@@ -144,6 +170,7 @@ private:
     const PrimInfo& info_;
     const GsOptions& o_;
     std::vector<GNode> nodes_;
+    std::vector<std::uint32_t> path_;
 };
 
 }  // namespace

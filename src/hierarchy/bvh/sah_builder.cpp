@@ -16,6 +16,14 @@ struct Split {
     std::uint32_t at = 0;  // binned: first bin on the right; sweep: primitives on the left
 };
 
+// The bin of centroid coordinate `c`: clamped to [0, nbins - 1], and 0 for a NaN (a scale that
+// overflowed), so that no float-to-int conversion is ever out of range.
+inline int bin_of(float c, float lo, float scale, int nbins) {
+    const float f = (c - lo) * scale;
+    if (!(f > 0)) return 0;
+    return f >= static_cast<float>(nbins - 1) ? nbins - 1 : static_cast<int>(f);
+}
+
 Split best_binned(const std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
                   const PrimInfo& info, const Box3& cb, int nbins) {
     Split best;
@@ -25,11 +33,11 @@ Split best_binned(const std::vector<std::uint32_t>& ids, std::uint32_t begin, st
     std::vector<std::uint32_t> right_n(nbins);
     for (int axis = 0; axis < 3; ++axis) {
         float lo = cb.lo[axis], ext = cb.hi[axis] - lo;
-        if (!(ext > 0)) continue;
         float scale = nbins / ext;
+        if (!(ext > 0) || !std::isfinite(scale)) continue;  // flat, or too thin to bin in float
         std::fill(bins.begin(), bins.end(), Bin{});
         for (std::uint32_t i = begin; i < end; ++i) {
-            int b = std::min(nbins - 1, static_cast<int>((info.centroids[ids[i]][axis] - lo) * scale));
+            const int b = bin_of(info.centroids[ids[i]][axis], lo, scale, nbins);
             bins[b].box.extend(info.bounds[ids[i]]);
             ++bins[b].n;
         }
@@ -116,7 +124,7 @@ BvhData build_sah(const Scene& s, const SahOptions& o) {
         // counted on.
         const float lo = cb.lo[sp.axis], scale = o.bins / (cb.hi[sp.axis] - lo);
         auto it = std::partition(ids.begin() + begin, ids.begin() + end, [&](std::uint32_t id) {
-            int b = std::min(o.bins - 1, static_cast<int>((info.centroids[id][sp.axis] - lo) * scale));
+            const int b = bin_of(info.centroids[id][sp.axis], lo, scale, o.bins);
             return b < static_cast<int>(sp.at);
         });
         return static_cast<std::uint32_t>(it - ids.begin());

@@ -119,6 +119,8 @@ Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool 
     if (empty_) {
         res_ = {1, 1, 1};
         box_ = Box3{{0, 0, 0}, {0, 0, 0}};
+    } else {
+        limit_references(s);
     }
     // Boundaries in double, rounded once: non-decreasing, first and last exactly the box faces.
     for (int a = 0; a < 3; ++a) {
@@ -172,8 +174,51 @@ Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool 
     for (std::size_t p = 0; p < pair_id.size(); ++p) refs_[fill[pair_cell[p]]++] = pair_id[p];
 }
 
+// Coincident primitives, or long thin ones spanning the scene, overlap nearly every cell: the
+// references grow as cells x primitives (10,000 copies of a triangle: 400 MB, and every ray
+// tests every copy in every cell). Two bounds, checked on the references the primitives' boxes
+// imply: memory, at most kRefsPerPrim per primitive (or kMinRefBudget in all); and time, a ray
+// crossing at most rx + ry + rz cells of average occupancy must not expect more than
+// kTestsPerPrim times the N tests of brute force (nor kMinTests, for a handful of primitives). The resolution is reduced, all axes alike,
+// until both hold; no SPD scene comes near either at the default density.
+void Grid::limit_references(const Scene& s) {
+    const std::uint64_t memory = std::max<std::uint64_t>(kMinRefBudget, kRefsPerPrim * s.size());
+    auto budget = [&](const std::array<int, 3>& r) {
+        const double tests = std::max(double(kTestsPerPrim) * double(s.size()), double(kMinTests));
+        const double time = tests * double(product(r)) / double(r[0] + r[1] + r[2]);
+        return std::min<double>(double(memory), time);
+    };
+    auto count = [&](const std::array<int, 3>& r, double limit) {
+        double total = 0;
+        for (std::uint32_t id = 0; id < s.size() && total <= limit; ++id) {
+            const Box3 pb = s.prim_bounds(id);
+            double n = 1;
+            for (int a = 0; a < 3; ++a) {
+                const double ext = double(box_.hi[a]) - box_.lo[a];
+                if (!(ext > 0) || r[a] == 1) continue;
+                const double f = r[a] / ext;
+                const double lo = std::clamp(std::floor((pb.lo[a] - double(box_.lo[a])) * f), 0.0, r[a] - 1.0);
+                const double hi = std::clamp(std::floor((pb.hi[a] - double(box_.lo[a])) * f), 0.0, r[a] - 1.0);
+                n *= hi - lo + 1;
+            }
+            total += n;
+        }
+        return total;
+    };
+    const std::array<int, 3> asked = res_;
+    while (product(res_) > 1 && count(res_, budget(res_)) > budget(res_))
+        for (int& r : res_) r = std::max(1, static_cast<int>(r * 0.8));
+    if (res_ != asked)
+        limits_.push_back(fmt::format("grid: resolution {}x{}x{} reduced to {}x{}x{}: the primitives' boxes overlap "
+                                      "so many cells that a ray would test more than {} times the primitives, or the "
+                                      "references exceed {} per primitive",
+                                      asked[0], asked[1], asked[2], res_[0], res_[1], res_[2], kTestsPerPrim,
+                                      kRefsPerPrim));
+}
+
 StructureStats Grid::compute_structure() const {
     StructureStats s;
+    s.limits = limits_;
     s.interior = 1;  // the grid itself: the one node a ray enters before its first cell
     s.leaves = cell_count();
     for (std::uint64_t c = 0; c < cell_count(); ++c) s.empty_leaves += offsets_[c] == offsets_[c + 1];

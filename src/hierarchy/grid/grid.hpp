@@ -66,6 +66,15 @@ protected:
     StructureStats compute_structure() const override;
 
 private:
+    /// Most references per primitive (and at least kMinRefBudget in all) before the resolution
+    /// is reduced; see limit_references.
+    static constexpr std::uint64_t kRefsPerPrim = 16, kMinRefBudget = std::uint64_t{1} << 20;
+    /// Expected primitive tests per ray, in units of the primitive count, before the
+    /// resolution is reduced; see limit_references.
+    static constexpr int kTestsPerPrim = 2, kMinTests = 64;
+    void limit_references(const Scene& s);
+    std::vector<std::string> limits_;
+
     std::uint64_t cell_index(int i, int j, int k) const {
         return static_cast<std::uint64_t>(i) +
                static_cast<std::uint64_t>(res_[0]) * (static_cast<std::uint64_t>(j) + static_cast<std::uint64_t>(res_[1]) * k);

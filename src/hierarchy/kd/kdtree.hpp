@@ -109,9 +109,10 @@ KdData build_sah(const Scene& s, const SahOptions& o);
 /// in box_entry: 0 * inf = NaN fails every compare and is ignored.
 inline bool clip(const Box3& b, const RayInv& r, float& t0, float& t1) {
     for (int a = 0; a < 3; ++a) {
-        float tn = (b.lo[a] - r.o[a]) * r.inv[a];
-        float tf = (b.hi[a] - r.o[a]) * r.inv[a];
-        if (tn > tf) std::swap(tn, tf);
+        // Faces by the direction's sign (as box_entry): a compare-and-swap with a NaN (origin in
+        // a face's plane) rejected rays of direction -0 lying in that face.
+        float tn = ((r.neg[a] ? b.hi[a] : b.lo[a]) - r.o[a]) * r.inv[a];
+        float tf = ((r.neg[a] ? b.lo[a] : b.hi[a]) - r.o[a]) * r.inv[a];
         // Multiplication keeps infinities infinite (inf - inf would be NaN and accept).
         tn *= tn > 0 ? 0.9999996f : 1.0000004f;
         tf *= tf > 0 ? 1.0000004f : 0.9999996f;

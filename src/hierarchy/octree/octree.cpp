@@ -1,4 +1,6 @@
 // `octree`: the build, structure statistics, the model tree and the registration.
+#include <fmt/format.h>
+
 #include "octree.hpp"
 #include "../common/tree_stats.hpp"
 
@@ -28,9 +30,11 @@ void Octree::make_leaf(std::uint32_t node, const std::vector<std::uint32_t>& ref
 // Recursion depth is at most max_depth <= kMaxDepth.
 void Octree::build(std::uint32_t node, const Box3& cell, int depth, std::vector<std::uint32_t>& refs,
                    const subdiv::Assigner& as) {
-    if (refs.size() <= static_cast<std::size_t>(o_.max_prims) || depth >= o_.max_depth ||
-        refs_.size() >= subdiv::kMaxRefs || nodes_.size() >= subdiv::kMaxNodes)
+    if (refs.size() <= static_cast<std::size_t>(o_.max_prims) || depth >= o_.max_depth) return make_leaf(node, refs);
+    if (refs_.size() >= subdiv::kMaxRefs || nodes_.size() >= subdiv::kMaxNodes) {
+        capped_ = true;
         return make_leaf(node, refs);
+    }
     const Vec3 c = subdiv::centre(cell);
     Box3 oct[8];
     for (int k = 0; k < 8; ++k) oct[k] = subdiv::octant(cell, c, k);
@@ -52,6 +56,17 @@ void Octree::build(std::uint32_t node, const Box3& cell, int depth, std::vector<
 }
 
 StructureStats Octree::compute_structure() const {
+    if (capped_) {
+        StructureStats s = compute_tree();
+        s.limits.push_back(fmt::format("octree: subdivision stopped at {} references or {} nodes (the memory bound); "
+                                       "leaves below it hold more primitives than max_prims",
+                                       subdiv::kMaxRefs, subdiv::kMaxNodes));
+        return s;
+    }
+    return compute_tree();
+}
+
+StructureStats Octree::compute_tree() const {
     StructureStats s = tree_structure(nodes_, [](const Node& n) { return n.leaf(); }, [](const Node&) { return 8u; });
     s.bytes = nodes_.size() * sizeof(Node) + refs_.size() * sizeof(std::uint32_t);
     return s;

@@ -1,5 +1,7 @@
 // `rc5d`: the beam test, the (lazy or eager) subdivision, structure statistics, the model tree
 // and the registration. The traversal is in rc5d.hpp.
+#include <fmt/format.h>
+
 #include "rc5d.hpp"
 
 #include <algorithm>
@@ -128,7 +130,10 @@ bool Rc5d::subdivide(Node& n, const Cell& cell, int level, int cube) const {
     const std::uint64_t need = 2 * sizeof(Node) + (a.size() + b.size()) * kRefBytes;
     std::uint64_t cur = bytes_.load(std::memory_order_relaxed);
     do {
-        if (opt_.max_bytes != 0 && cur + need > opt_.max_bytes) return false;
+        if (cur + need > opt_.max_bytes) {
+            capped_.store(true, std::memory_order_relaxed);
+            return false;
+        }
     } while (!bytes_.compare_exchange_weak(cur, cur + need, std::memory_order_relaxed));
     auto kids = std::make_unique<Node[]>(2);
     init_node(kids[0], std::move(a), level + 1);
@@ -179,6 +184,10 @@ void Rc5d::build_eager() {
 
 StructureStats Rc5d::compute_structure() const {
     StructureStats s;
+    if (capped_.load(std::memory_order_relaxed))
+        s.limits.push_back(fmt::format("rc5d: subdivision stopped at the memory cap max_bytes={}; beams below it hold "
+                                       "more candidates than max_prims",
+                                       opt_.max_bytes));
     s.interior = 1;  // the cube selection: the root every classified ray passes
     std::uint64_t nodes = 0;
     std::vector<std::pair<const Node*, int>> stack;
@@ -272,14 +281,14 @@ const Registration reg{
       {"build", "lazy",
        "lazy: a beam is subdivided when the first ray reaches it (Arvo and Kirk); eager: everything at build time"},
       {"max_bytes", "1073741824",
-       "memory cap in bytes: subdivision stops where the structure would exceed it (0: no cap); with a cap that is "
-       "reached, lazy and eager trees can differ"}},
+       "memory cap in bytes: subdivision stops where the structure would exceed it (at most 2^36; a bound always "
+       "holds, as eager builds grow exponentially); with a cap that is reached, lazy and eager trees can differ"}},
      [](const Scene& s, const Params& p) {
          Options o;
          o.max_prims = static_cast<int>(p.integer("max_prims", 0, 1 << 30));
          o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
          o.lazy = p.choice("build", {"lazy", "eager"}) == "lazy";
-         o.max_bytes = static_cast<std::uint64_t>(p.integer("max_bytes", 0, 1LL << 50));
+         o.max_bytes = static_cast<std::uint64_t>(p.integer("max_bytes", 1, 1LL << 36));
          return std::make_unique<Rc5d>(s, o);
      }}};
 

@@ -59,7 +59,7 @@ struct Options {
     /// 20 levels, SPD scenes under camera rays still test 40 to 2000 candidates per ray.
     int max_depth = 30;
     bool lazy = true;    ///< subdivide on the first visit (true) or all at build time
-    std::uint64_t max_bytes = std::uint64_t{1} << 30;  ///< memory cap stopping subdivision; 0 = none
+    std::uint64_t max_bytes = std::uint64_t{1} << 30;  ///< memory cap stopping subdivision (>= 1)
 };
 
 /// A 5D hypercube: dimensions 0..2 the origin box, 3 = u, 4 = v.
@@ -219,6 +219,7 @@ private:
     mutable std::array<Node, 6> cubes_;
     mutable std::array<std::mutex, 64> locks_;
     mutable std::atomic<std::uint64_t> bytes_{0};
+    mutable std::atomic<bool> capped_{false};  ///< the cap refused a subdivision
 };
 
 }  // namespace rtcost::rc5d

@@ -1,0 +1,47 @@
+#pragma once
+// Pieces shared by the libFuzzer harnesses: a scratch file per process, a small scene, and the
+// check that a hierarchy's closest hits are brute force's (abort otherwise, which libFuzzer
+// records as a crash with the input that caused it).
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <string>
+#include <string_view>
+
+#include "rtcost/hierarchy.hpp"
+#include "rtcost/io.hpp"
+#include "rtcost/trace.hpp"
+
+namespace rtcost::fuzz {
+
+/// Writes `bytes` to /tmp/rtcost-fuzz-PID`ext` and returns the path.
+inline std::string scratch_file(std::string_view bytes, const std::string& ext) {
+    std::string path = "/tmp/rtcost-fuzz-" + std::to_string(::getpid()) + ext;
+    std::ofstream(path, std::ios::binary | std::ios::trunc).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    return path;
+}
+
+/// Aborts with a message when `h` and `brute` disagree on any closest hit (same rules as the
+/// tests: the same primitive with exactly the same t, or a tie within 1e-6 relative).
+inline void require_same_hits(const Hierarchy& h, const Hierarchy& brute, std::span<const Ray> rays, const char* what) {
+    TraceOptions opt;
+    opt.threads = 1;
+    const auto want = trace_rays(brute, rays, opt).hits, got = trace_rays(h, rays, opt).hits;
+    for (std::size_t i = 0; i < rays.size(); ++i) {
+        bool ok = want[i].hit() == got[i].hit();
+        if (ok && want[i].hit()) {
+            const float tol = want[i].prim == got[i].prim ? 0.0f : 1e-6f * std::fabs(want[i].t);
+            ok = std::fabs(want[i].t - got[i].t) <= tol;
+        }
+        if (!ok) {
+            const std::string name(h.name());
+            std::fprintf(stderr, "%s: %s differs from brute force on ray %zu: want %d t %.9g, got %d t %.9g\n", what,
+                         name.c_str(), i, want[i].prim, double(want[i].t), got[i].prim, double(got[i].t));
+            std::abort();
+        }
+    }
+}
+
+}  // namespace rtcost::fuzz

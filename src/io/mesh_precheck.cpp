@@ -1,0 +1,276 @@
+// Checks of PLY and OFF files before assimp reads them. Assimp is lenient where rtcost must not
+// be: a PLY header without `end_header` makes it spin forever, a face index beyond the vertices
+// is clamped (OFF) or read from beyond them, and a vertex count larger than the vertices given
+// loads silently. These files are simple enough to walk once here; other formats go to assimp
+// unchecked.
+#include "mesh_precheck.hpp"
+
+#include <algorithm>
+#include <bit>
+#include <cctype>
+#include <charconv>
+#include <cstdint>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "rtcost/error.hpp"
+
+namespace rtcost {
+namespace {
+
+std::string lower_extension(const std::string& path) {
+    std::string ext = std::filesystem::path(path).extension().string();
+    std::transform(ext.begin(), ext.end(), ext.begin(), [](unsigned char c) { return std::tolower(c); });
+    return ext;
+}
+
+std::string read_whole(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw InputError(path, 0, "cannot open file");
+    return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+bool is_space(char c) { return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f'; }
+
+/// Whitespace-separated tokens of `s` from `pos`, with the line of each (for ASCII data).
+class Words {
+public:
+    Words(std::string_view s, std::size_t pos, int line) : s_(s), pos_(pos), line_(line) {}
+    /// The next token, or empty at the end.
+    std::string_view next() {
+        while (pos_ < s_.size() && is_space(s_[pos_])) line_ += s_[pos_++] == '\n';
+        std::size_t start = pos_;
+        while (pos_ < s_.size() && !is_space(s_[pos_])) ++pos_;
+        return s_.substr(start, pos_ - start);
+    }
+    /// Skips the rest of the current line.
+    void skip_line() {
+        while (pos_ < s_.size() && s_[pos_] != '\n') ++pos_;
+    }
+    int line() const { return line_; }
+
+private:
+    std::string_view s_;
+    std::size_t pos_;
+    int line_;
+};
+
+bool to_int(std::string_view t, long long& v) {
+    auto [p, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+    return ec == std::errc() && p == t.data() + t.size();
+}
+
+std::string shown(std::string_view t) {
+    return t.size() <= 40 ? std::string(t) : std::string(t.substr(0, 40)) + "...";
+}
+
+// ---- PLY ----
+
+struct PlyProperty {
+    int size = 0;        // scalar size in bytes, or the list's item size
+    int count_size = 0;  // list count size; 0 for a scalar
+    bool is_float = false;
+    bool index = false;  // the face list of vertex indices
+};
+struct PlyElement {
+    std::string name;
+    long long count = 0;
+    std::vector<PlyProperty> props;
+};
+
+int ply_type_size(std::string_view t, bool& is_float) {
+    is_float = t == "float" || t == "float32" || t == "double" || t == "float64";
+    if (t == "char" || t == "uchar" || t == "int8" || t == "uint8") return 1;
+    if (t == "short" || t == "ushort" || t == "int16" || t == "uint16") return 2;
+    if (t == "int" || t == "uint" || t == "int32" || t == "uint32" || t == "float" || t == "float32") return 4;
+    if (t == "double" || t == "float64") return 8;
+    return 0;
+}
+
+void check_ply(const std::string& path, const std::string& bytes) {
+    auto fail = [&](int line, const std::string& what) { throw InputError(path, line, "PLY: " + what); };
+    // The header is text ending in a line `end_header`; without one assimp never returns.
+    std::size_t end = std::string::npos;
+    for (std::size_t p = 0; p < bytes.size();) {
+        std::size_t nl = bytes.find('\n', p);
+        std::string_view l(bytes.data() + p, (nl == std::string::npos ? bytes.size() : nl) - p);
+        while (!l.empty() && (l.back() == '\r' || l.back() == ' ')) l.remove_suffix(1);
+        if (l == "end_header") {
+            end = nl == std::string::npos ? bytes.size() : nl + 1;
+            break;
+        }
+        if (nl == std::string::npos) break;
+        p = nl + 1;
+    }
+    if (end == std::string::npos) fail(0, "the header has no 'end_header' line");
+
+    std::vector<PlyElement> elements;
+    std::string format;
+    Words w(std::string_view(bytes).substr(0, end), 0, 1);
+    for (std::string_view t = w.next(); !t.empty(); t = w.next()) {
+        const int line = w.line();
+        if (t == "comment" || t == "obj_info" || t == "ply") {
+            if (t != "ply") w.skip_line();
+        } else if (t == "format") {
+            format = std::string(w.next());
+            w.skip_line();
+        } else if (t == "element") {
+            PlyElement e;
+            e.name = std::string(w.next());
+            if (!to_int(w.next(), e.count) || e.count < 0) fail(line, fmt::format("bad count for element '{}'", shown(e.name)));
+            elements.push_back(std::move(e));
+        } else if (t == "property") {
+            if (elements.empty()) fail(line, "property before any element");
+            PlyProperty p;
+            std::string_view type = w.next();
+            if (type == "list") {
+                bool f = false;
+                p.count_size = ply_type_size(w.next(), f);
+                p.size = ply_type_size(w.next(), p.is_float);
+                std::string_view name = w.next();
+                p.index = elements.back().name == "face" && (name == "vertex_indices" || name == "vertex_index");
+                if (p.count_size == 0 || p.size == 0 || f) fail(line, "bad list property types");
+            } else {
+                p.size = ply_type_size(type, p.is_float);
+                w.next();
+                if (p.size == 0) fail(line, fmt::format("unknown property type '{}'", shown(type)));
+            }
+            elements.back().props.push_back(p);
+        } else if (t == "end_header") {
+            break;
+        }
+    }
+    long long vertices = 0;
+    for (const auto& e : elements)
+        if (e.name == "vertex") vertices = e.count;
+
+    if (format == "ascii") {
+        Words d(bytes, end, w.line() + 1);
+        for (const auto& e : elements) {
+            for (long long i = 0; i < e.count; ++i) {
+                for (const PlyProperty& p : e.props) {
+                    long long n = 1;
+                    if (p.count_size) {
+                        std::string_view t = d.next();
+                        if (t.empty()) fail(0, fmt::format("file ends at {} {} of {} declared", e.name, i, e.count));
+                        if (!to_int(t, n) || n < 0) fail(d.line(), fmt::format("bad list length '{}'", shown(t)));
+                    }
+                    for (long long k = 0; k < n; ++k) {
+                        std::string_view t = d.next();
+                        if (t.empty()) fail(0, fmt::format("file ends at {} {} of {} declared", e.name, i, e.count));
+                        long long idx = 0;
+                        if (p.index && (!to_int(t, idx) || idx < 0 || idx >= vertices))
+                            fail(d.line(), fmt::format("face {} refers to vertex '{}'; there are {}", i, shown(t), vertices));
+                    }
+                }
+            }
+        }
+        return;
+    }
+    const bool little = format == "binary_little_endian";
+    if (!little && format != "binary_big_endian") fail(0, fmt::format("unknown format '{}'", shown(format)));
+    std::size_t pos = end;
+    auto read_uint = [&](int size, long long& out) {
+        if (pos + size > bytes.size()) return false;
+        std::uint64_t v = 0;
+        for (int b = 0; b < size; ++b) {
+            const auto byte = static_cast<unsigned char>(bytes[pos + (little ? b : size - 1 - b)]);
+            v |= std::uint64_t{byte} << (8 * b);
+        }
+        pos += size;
+        out = static_cast<long long>(v);
+        return true;
+    };
+    for (const auto& e : elements) {
+        for (long long i = 0; i < e.count; ++i) {
+            for (const PlyProperty& p : e.props) {
+                long long n = 1;
+                if (p.count_size && !read_uint(p.count_size, n))
+                    fail(0, fmt::format("file ends at {} {} of {} declared", e.name, i, e.count));
+                for (long long k = 0; k < n; ++k) {
+                    long long idx = 0;
+                    if (!read_uint(p.size, idx)) fail(0, fmt::format("file ends at {} {} of {} declared", e.name, i, e.count));
+                    // Signed index types: a negative index reads as a huge unsigned one here.
+                    if (p.index && idx >= vertices)
+                        fail(0, fmt::format("face {} refers to vertex {}; there are {}", i, idx, vertices));
+                }
+            }
+        }
+    }
+}
+
+// ---- OFF ----
+
+void check_off(const std::string& path, const std::string& bytes) {
+    auto fail = [&](int line, const std::string& what) { throw InputError(path, line, "OFF: " + what); };
+    // Lines without comments and blank lines, with their line numbers.
+    std::vector<std::pair<std::string_view, int>> lines;
+    int number = 0;
+    for (std::size_t p = 0; p <= bytes.size();) {
+        std::size_t nl = bytes.find('\n', p);
+        if (nl == std::string::npos) nl = bytes.size();
+        ++number;
+        std::string_view l(bytes.data() + p, nl - p);
+        if (auto h = l.find('#'); h != std::string_view::npos) l = l.substr(0, h);
+        while (!l.empty() && is_space(l.front())) l.remove_prefix(1);
+        while (!l.empty() && is_space(l.back())) l.remove_suffix(1);
+        if (!l.empty()) lines.emplace_back(l, number);
+        p = nl + 1;
+    }
+    if (lines.empty()) fail(0, "empty file");
+    std::string_view head = lines[0].first;
+    std::size_t at = 1;
+    if (head.find("BINARY") != std::string_view::npos) return;  // binary OFF: left to assimp
+    auto kw = head.substr(0, std::min(head.find_first_of(" \t"), head.size()));
+    if (kw.size() < 3 || kw.substr(kw.size() - 3) != "OFF") return;  // not the OFF we know
+    std::string_view counts = head.substr(kw.size());
+    while (!counts.empty() && is_space(counts.front())) counts.remove_prefix(1);
+    if (counts.empty()) {
+        if (at >= lines.size()) fail(lines[0].second, "no vertex and face counts");
+        counts = lines[at++].first;
+    }
+    Words cw(counts, 0, 0);
+    long long nv = 0, nf = 0;
+    if (!to_int(cw.next(), nv) || !to_int(cw.next(), nf) || nv < 0 || nf < 0)
+        fail(lines[at - 1].second, "bad vertex and face counts");
+    if (static_cast<long long>(lines.size() - at) < nv)
+        fail(0, fmt::format("declares {} vertices, the file has {} lines after the counts", nv, lines.size() - at));
+    at += static_cast<std::size_t>(nv);
+    if (static_cast<long long>(lines.size() - at) < nf)
+        fail(0, fmt::format("declares {} faces, the file has {} lines after the vertices", nf, lines.size() - at));
+    for (long long f = 0; f < nf; ++f) {
+        const auto [l, line] = lines[at + static_cast<std::size_t>(f)];
+        Words fw(l, 0, line);
+        long long k = 0;
+        if (!to_int(fw.next(), k) || k < 0) fail(line, fmt::format("face {}: bad vertex count", f));
+        for (long long i = 0; i < k; ++i) {
+            std::string_view t = fw.next();
+            long long idx = 0;
+            if (t.empty()) fail(line, fmt::format("face {}: {} vertices declared, {} given", f, k, i));
+            if (!to_int(t, idx) || idx < 0 || idx >= nv)
+                fail(line, fmt::format("face {} refers to vertex '{}'; there are {}", f, shown(t), nv));
+        }
+    }
+}
+
+}  // namespace
+
+void precheck_mesh(const std::string& path) {
+    const std::string ext = lower_extension(path);
+    if (ext != ".ply" && ext != ".off") return;
+    const std::string bytes = read_whole(path);
+    if (ext == ".ply") {
+        if (bytes.size() >= 3 && bytes.compare(0, 3, "ply") == 0) check_ply(path, bytes);
+    } else {
+        check_off(path, bytes);
+    }
+}
+
+}  // namespace rtcost

@@ -1,0 +1,346 @@
+// Regression tests for issue 17's classes of failure, at the library level: float range of the
+// intersection tests and the load-time limits, builders' bounds, the ray-file checks, the line
+// generator on flat scenes, the NFF reader's messages, and the output files.
+#include <sys/stat.h>
+
+#include <filesystem>
+#include <fstream>
+#include <random>
+
+#include "test_support.hpp"
+
+namespace rtcost::test {
+namespace {
+namespace fs = std::filesystem;
+
+std::string thrown(const std::function<void()>& f) {
+    try {
+        f();
+    } catch (const InputError& e) {
+        return e.what();
+    }
+    return "";
+}
+
+bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+fs::path scratch() {
+    fs::path d = fs::temp_directory_path() / ("rtcost_rel_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+}
+
+void write_file(const fs::path& p, const std::string& bytes) { std::ofstream(p, std::ios::binary) << bytes; }
+
+std::string ray_bytes(const std::vector<Ray>& rays) {
+    std::string b;
+    for (const Ray& r : rays) {
+        float f[8] = {r.o.x, r.o.y, r.o.z, r.d.x, r.d.y, r.d.z, r.tmin, r.tmax};
+        b.append(reinterpret_cast<const char*>(f), 32);
+    }
+    return b;
+}
+
+// ---- the intersection's float range ----
+
+TEST(Reliability, TrianglesAreHitAtEveryScaleTheLimitsAllow) {
+    // A ray at the centroid of a triangle of size k at distance 3k (k from 1e-30 to 1e18) hits it
+    // at t = 3 (unit direction scaled by k): the edge products overflow float from k ~ 1e13 and
+    // underflow below ~1e-19; the double path takes over there.
+    for (int e = -30; e <= 18; ++e) {
+        const float k = std::pow(10.0f, static_cast<float>(e));
+        Triangle t{Vec3{-1, -1, 0} * k, Vec3{1, -1, 0} * k, Vec3{0, 1, 0} * k};
+        Ray r{Vec3{0, -1.0f / 3, 3} * k, Vec3{0, 0, -1}, 0, kInf};
+        float hit = -1;
+        ASSERT_TRUE(intersect(t, r, hit)) << "scale 1e" << e;
+        EXPECT_NEAR(hit / k, 3.0f, 3e-6f) << "scale 1e" << e;
+        // A ray beside it misses.
+        Ray miss{Vec3{2, 0, 3} * k, Vec3{0, 0, -1}, 0, kInf};
+        EXPECT_FALSE(intersect(t, miss, hit)) << "scale 1e" << e;
+    }
+}
+
+TEST(Reliability, ThinTriangleTwoBillionLongHasNoFalseHits) {
+    Triangle t{{-1e9f, 0, 0}, {1e9f, 0, 0}, {-1e9f, 1, 0}};
+    float hit = 0;
+    // The triangle's width at x = 0 is 0.5: a ray at y = 0.75 passes beside it.
+    EXPECT_FALSE(intersect(t, Ray{{0, 0.75f, 1}, {0, 0, -1}, 0, kInf}, hit));
+    EXPECT_TRUE(intersect(t, Ray{{0, 0.25f, 1}, {0, 0, -1}, 0, kInf}, hit));
+}
+
+TEST(Reliability, ShortConeHasBoundsAndANormal) {
+    Cone c{{0, 0, 0}, 1, {1e-30f, 0, 0}, 1};
+    Box3 b = bounds(c);
+    EXPECT_FALSE(b.empty());
+    EXPECT_TRUE(is_finite(b.lo) && is_finite(b.hi));
+    Vec3 n = normal_at(c, {0, 1, 0});
+    EXPECT_TRUE(is_finite(n));
+    EXPECT_NEAR(length(n), 1.0f, 1e-6f);
+    EXPECT_TRUE(is_finite(normal_at(Sphere{{0, 0, 0}, 1e-30f}, {1e-30f, 0, 0})));
+    EXPECT_TRUE(is_finite(normal_at(Triangle{{0, 0, 0}, {1e-30f, 0, 0}, {0, 1e-30f, 0}})));
+}
+
+TEST(Reliability, ConeHitsLieOnTheSurfaceEvenForAFlatCone) {
+    // Every reported hit's point must be on the frustum: at axial distance s in [0, h] and at
+    // distance rb + k s from the axis (to 1e-4 of the larger radius). The flat one (radius 2e9,
+    // axis 1) once gave false hits.
+    const Cone cones[] = {{{0, 0, 0}, 2e9f, {0, 0, 1}, 1}, {{0, 0, 0}, 1, {0, 0, 2}, 0.5f}, {{1, 2, 3}, 0, {2, 2, 3}, 3}};
+    std::mt19937 rng(4);
+    for (const Cone& c : cones) {
+        const Box3 b = bounds(c);
+        const double h = length(c.apex - c.base);
+        const double rmax = std::max(c.base_radius, c.apex_radius);
+        std::size_t hits = 0;
+        for (const Ray& r : random_rays(b, 20000, 6)) {
+            float t = 0;
+            if (!intersect(c, r, t)) continue;
+            ++hits;
+            const double px = double(r.o.x) + double(r.d.x) * t - c.base.x, py = double(r.o.y) + double(r.d.y) * t - c.base.y,
+                         pz = double(r.o.z) + double(r.d.z) * t - c.base.z;
+            const double wx = (c.apex.x - c.base.x) / h, wy = (c.apex.y - c.base.y) / h, wz = (c.apex.z - c.base.z) / h;
+            const double sa = px * wx + py * wy + pz * wz;
+            const double qx = px - sa * wx, qy = py - sa * wy, qz = pz - sa * wz;
+            const double radial = std::sqrt(qx * qx + qy * qy + qz * qz);
+            const double want = c.base_radius + (c.apex_radius - c.base_radius) * sa / h;
+            EXPECT_NEAR(radial, want, 1e-4 * rmax) << "cone " << c.base_radius << " s " << sa;
+            EXPECT_GE(sa, -1e-4 * (h + rmax));
+            EXPECT_LE(sa, h + 1e-4 * (h + rmax));
+        }
+        EXPECT_GT(hits, 100u);
+    }
+}
+
+// ---- load-time limits ----
+
+TEST(Reliability, CoordinatesBeyondTheLimitAreRefusedWithTheLimit) {
+    std::string e = thrown([] { read_nff("s 0 0 0 1\ns 2e12 0 0 1\n", "big.nff"); });
+    EXPECT_TRUE(contains(e, "big.nff:2:")) << e;
+    EXPECT_TRUE(contains(e, "1e+12")) << e;
+    e = thrown([] { read_nff("p 3\n0 0 0\n1e13 0 0\n0 1 0\n", "poly.nff"); });
+    EXPECT_TRUE(contains(e, "poly.nff:3:")) << e;
+    // A whole scene below the smallest extent: refused by check_scene (load_scene calls it).
+    fs::path p = scratch() / "tiny.nff";
+    write_file(p, "s 0 0 0 1e-14\n");
+    e = thrown([&] { load_scene(p.string()); });
+    EXPECT_TRUE(contains(e, "below 1e-12")) << e;
+    // 1e-11 and 1e11 are inside the limits.
+    write_file(p, "s 0 0 0 1e-11\ns 1e11 0 0 1\n");
+    EXPECT_EQ(load_scene(p.string()).size(), 2u);
+}
+
+TEST(Reliability, SceneWithoutPrimitivesNamesWhatWasSkipped) {
+    std::string e = thrown([] { read_nff("s 0 0 0 0\nc 0 0 0 1 0 0 0 1\n", "deg.nff"); });
+    EXPECT_TRUE(contains(e, "scene has no primitives")) << e;
+    EXPECT_TRUE(contains(e, "2 warnings")) << e;
+    EXPECT_TRUE(contains(e, "deg.nff:1: degenerate sphere")) << e;
+}
+
+TEST(Reliability, ByteOrderMarkIsSkippedAndLongTokensAreCut) {
+    EXPECT_EQ(read_nff("\xEF\xBB\xBFs 0 0 0 1\n", "bom.nff").size(), 1u);
+    std::string e = thrown([] { read_nff("s 0 0 0 1\n" + std::string(300000, 'x') + "\n", "long.nff"); });
+    EXPECT_TRUE(contains(e, "long.nff:2: unknown entity")) << e;
+    EXPECT_LT(e.size(), 200u);
+    EXPECT_TRUE(contains(e, "300000 characters")) << e;
+}
+
+TEST(Reliability, NonPlanarPolygonIsFlattenedSoEveryHierarchyFindsItsHits) {
+    // The fourth vertex lies 0.5 off the plane of the first three.
+    Scene s = read_nff("p 4\n0 0 0\n1 0 0\n1 1 0.5\n0 1 0\ns 3 3 3 0.5\n", "warp.nff");
+    ASSERT_EQ(s.size(), 2u);
+    ASSERT_EQ(s.warnings.size(), 1u);
+    EXPECT_TRUE(contains(s.warnings[0], "non-planar")) << s.warnings[0];
+    // After flattening, every vertex lies on the polygon's plane.
+    const Polygon& p = s.polygons[0];
+    for (std::uint32_t i = 0; i < p.count; ++i)
+        EXPECT_NEAR(dot(p.normal, s.polygon_vertices[p.first + i]), p.plane_d, 1e-6f);
+    std::vector<Ray> rays = hard_rays(s, 3000, 4);
+    expect_variants_match_brute(s, rays, "warp", {{"bvh-sah", {}}, {"grid", {}}, {"kd-sah", {}}, {"bsp", {}},
+                                                  {"octree", {}}, {"rc5d", {}}, {"grid", {"assign=exact"}}});
+}
+
+// ---- builders' bounds ----
+
+Scene sphereflake_of_tiny_spheres() {
+    Scene s;
+    std::mt19937 rng(8);
+    std::uniform_real_distribution<float> u(-1, 1);
+    for (int i = 0; i < 800; ++i) s.add(Sphere{{u(rng), u(rng), u(rng)}, 1e-30f}, 0);
+    s.add(Sphere{{0, 0, 0}, 0.3f}, 0);
+    s.finalize();
+    return s;
+}
+
+TEST(Reliability, GoldsmithSalmonKeepsItsDepthBound) {
+    Scene s = sphereflake_of_tiny_spheres();
+    for (int depth : {64, 12, 5}) {
+        auto h = build_hierarchy(s, "bvh-gs", {"max_depth=" + std::to_string(depth)});
+        EXPECT_LE(h->structure().depth, depth);
+    }
+    Scene tetra = builtin_scene("tetra", 7);
+    auto h = build_hierarchy(tetra, "bvh-gs");
+    EXPECT_LE(h->structure().depth, 64);
+    std::vector<Ray> rays = hard_rays(s, 2000, 3);
+    expect_variants_match_brute(s, rays, "tiny spheres", {{"bvh-gs", {}}, {"bvh-gs", {"max_depth=6"}}, {"bvh-sah", {}}});
+}
+
+TEST(Reliability, SahBinsNeverLeaveTheirRangeOnThinOrTinyExtents) {
+    Scene s;
+    // Centroids 1e-38 apart (the bin scale overflows float) and a cone whose axis is 1e-30 long.
+    for (int i = 0; i < 50; ++i) s.add(Sphere{{1e-38f * i, 0, 0}, 0.5f}, 0);
+    s.add(Cone{{0, 0, 0}, 0.5f, {0, 0, 1e-30f}, 0.5f}, 0);
+    s.finalize();
+    std::vector<Ray> rays = hard_rays(s, 1000, 2);
+    expect_variants_match_brute(s, rays, "thin", {{"bvh-sah", {}}, {"bvh-sah", {"sweep=1"}}, {"bvh-median", {}}});
+}
+
+TEST(Reliability, Rc5dAlwaysHasAMemoryCapAndReportsReachingIt) {
+    Scene s = builtin_scene("balls", 2);
+    EXPECT_TRUE(contains(thrown([&] { build_hierarchy(s, "rc5d", {"max_bytes=0"}); }), "max_bytes=0")) ;
+    auto h = build_hierarchy(s, "rc5d", {"build=eager", "max_bytes=200000"});
+    const StructureStats st = h->structure();
+    EXPECT_LE(st.bytes, 200000u + 4096u);
+    ASSERT_EQ(st.limits.size(), 1u);
+    EXPECT_TRUE(contains(st.limits[0], "max_bytes=200000")) << st.limits[0];
+}
+
+TEST(Reliability, RaysOfDirectionMinusZeroInABoxFaceAreNotLost) {
+    // Found by the ray-file fuzzer: origin on the plane x = 0 (a kd-median node's face), direction
+    // (-0, 0, -1). The slab test's compare-and-swap met a NaN and rejected the ray on both sides.
+    Scene s = builtin_scene("balls", 1);
+    std::vector<Ray> rays;
+    for (float dx : {0.0f, -0.0f})
+        for (float dy : {0.0f, -0.0f})
+            for (Vec3 o : {Vec3{0, 0, 0}, Vec3{0, 0, 1.1754944e-38f}, Vec3{0, 0.3f, 0.2f}, Vec3{-12, 0, 0.1f}})
+                rays.push_back({o, {dx, dy, -1}, 0, kInf});
+    for (const Ray& r : std::vector<Ray>(rays)) rays.push_back({r.o, {r.d.x, -1, r.d.y}, 0, kInf});
+    std::vector<Variant> all;
+    for (const HierarchyInfo* h : hierarchies())
+        if (h->name != "embree" && h->name != "brute") all.push_back({h->name, {}});
+    all.push_back({"kd-sah", {"assign=exact"}});
+    all.push_back({"bsp", {"traversal=recursive"}});
+    all.push_back({"octree", {"traversal=recursive"}});
+    expect_variants_match_brute(s, rays, "-0 in a face", all);
+}
+
+// ---- rays ----
+
+TEST(Reliability, RayFilesOutsideWhatTracingHandlesAreRefused) {
+    fs::path p = scratch() / "bad.rays";
+    const Ray good{{0, 0, 5}, {0, 0, -1}, 0, kInf};
+    struct Case {
+        Ray ray;
+        const char* says;
+    };
+    const Case cases[] = {
+        {{{0, 0, 5}, {0, 0, -1}, -1, kInf}, "tmin -1 is negative"},
+        {{{2e12f, 0, 5}, {0, 0, -1}, 0, kInf}, "beyond +-1e+12"},
+        {{{0, 0, 5}, {0, 0, -3e38f}, 0, kInf}, "outside [1e-12, 1e+12]"},
+        {{{0, 0, 5}, {0, 1e-14f, -1e-13f}, 0, kInf}, "outside [1e-12, 1e+12]"},
+    };
+    for (const Case& c : cases) {
+        write_file(p, ray_bytes({good, c.ray}));
+        const std::string e = thrown([&] { read_rays(p.string()); });
+        EXPECT_TRUE(contains(e, "ray 1 (byte 32)")) << e;
+        EXPECT_TRUE(contains(e, c.says)) << e;
+    }
+    write_file(p, ray_bytes({good}));
+    EXPECT_EQ(read_rays(p.string()).size(), 1u);
+    EXPECT_TRUE(contains(thrown([&] { read_rays(scratch().string()); }), "is a directory"));
+}
+
+TEST(Reliability, LinesThroughFlatAndPointBoxesReturn) {
+    // One axis-aligned triangle: the box is flat in z (the rejection loop used to never accept).
+    const Box3 flat{{0, 0, 0}, {1, 1, 0}};
+    std::vector<Ray> rays = line_rays(flat, 2000, 1);
+    ASSERT_EQ(rays.size(), 2000u);
+    Scene s;
+    s.add(Triangle{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}}, 0);
+    s.finalize();
+    auto brute = build_hierarchy(s, "brute");
+    std::size_t hits = 0;
+    for (const Hit& h : closest_hits(*brute, rays)) hits += h.hit();
+    EXPECT_GT(hits, 500u);  // half the square is the triangle
+    EXPECT_EQ(line_rays(Box3{{1, 1, 1}, {1, 1, 1}}, 10, 1).size(), 10u);
+}
+
+TEST(Reliability, CameraOfADegenerateSceneIsFinite) {
+    Scene s;
+    s.add(Sphere{{1, 1, 1}, 1e-11f}, 0);
+    s.finalize();
+    for (const Ray& r : camera_rays(s.camera, 4, 4)) {
+        EXPECT_TRUE(is_finite(r.o));
+        EXPECT_TRUE(is_finite(r.d));
+    }
+    EXPECT_TRUE(is_finite(s.lights.at(0).position));
+}
+
+TEST(Reliability, SizeAndCountAreBounded) {
+    int w = 0, h = 0;
+    EXPECT_TRUE(contains(thrown([&] { parse_size("65536x65536", "--size", w, h); }), "4294967296 rays"));
+    EXPECT_NO_THROW(parse_size("4096x4096", "--size", w, h));
+}
+
+// ---- output files ----
+
+TEST(Reliability, OutputOntoADeviceALinkOrADirectory) {
+    // A device is written in place, not replaced by a regular file.
+    write_file_atomic("/dev/null", "abc");
+    struct stat st{};
+    ASSERT_EQ(::stat("/dev/null", &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode));
+    // A full device reports the write failure.
+    if (fs::exists("/dev/full")) {
+        EXPECT_TRUE(contains(thrown([] { write_file_atomic("/dev/full", std::string(100000, 'x')); }), "write failed"));
+    }
+    // Through a symbolic link: the target gets the bytes and the link stays a link.
+    fs::path d = scratch();
+    fs::path target = d / "target.bin", link = d / "link.bin";
+    fs::remove(link);
+    write_file(target, "old");
+    fs::create_symlink(target, link);
+    write_file_atomic(link.string(), "new bytes");
+    EXPECT_TRUE(fs::is_symlink(link));
+    std::ifstream in(target, std::ios::binary);
+    std::string got((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    EXPECT_EQ(got, "new bytes");
+    // A directory: refused, naming it.
+    const std::string e = thrown([&] { write_file_atomic(d.string(), "x"); });
+    EXPECT_TRUE(contains(e, d.string() + ": is a directory")) << e;
+}
+
+
+// ---- threads ----
+
+TEST(Reliability, ThreadedTracingGivesOneThreadsHitsAndCountersInEveryHierarchy) {
+    // Run under ThreadSanitizer by scripts/sanitize.sh: every hierarchy, the lazily grown rc5d
+    // included (its beams are subdivided by whichever thread reaches them first).
+    Scene s = builtin_scene("balls", 2);
+    std::vector<Ray> rays = random_rays(s.bounds(), 6000, 21);
+    for (const HierarchyInfo* info : hierarchies()) {
+        SCOPED_TRACE(info->name);
+        TraceOptions one, many;
+        one.threads = 1;
+        one.count = info->name != "embree";
+        many = one;
+        many.threads = 0;  // every core
+        auto a = build_hierarchy(s, info->name), b = build_hierarchy(s, info->name);
+        TraceResult r1 = trace_rays(*a, rays, one), rn = trace_rays(*b, rays, many);
+        ASSERT_EQ(r1.hits.size(), rn.hits.size());
+        std::size_t differ = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i)
+            differ += r1.hits[i].prim != rn.hits[i].prim || r1.hits[i].t != rn.hits[i].t;
+        EXPECT_EQ(differ, 0u);
+        if (one.count) {
+            EXPECT_EQ(r1.counters.prim_tests(), rn.counters.prim_tests());
+            EXPECT_EQ(r1.counters.steps, rn.counters.steps);
+        }
+        EXPECT_LE(rn.threads, default_threads());
+    }
+    TraceOptions lots;
+    lots.threads = 1000;
+    auto h = build_hierarchy(s, "bvh-sah");
+    EXPECT_EQ(trace_rays(*h, rays, lots).threads, default_threads());
+}
+
+}  // namespace
+}  // namespace rtcost::test

@@ -1,0 +1,145 @@
+// Regression tests for issue 17 through the rtcost binary (RTCOST_CLI): exit codes and messages
+// for bad options and inputs, outputs onto devices, links and directories, the mesh checks that
+// assimp does not make, and hangs that must now end.
+#include <sys/stat.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+namespace {
+namespace fs = std::filesystem;
+
+struct CliResult {
+    int code;
+    std::string out, err;
+};
+
+fs::path dir() {
+    fs::path d = fs::temp_directory_path() / ("rtcost_relcli_" + std::to_string(::getpid()));
+    fs::create_directories(d);
+    return d;
+}
+
+std::string slurp(const fs::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+// Runs the binary with a time limit (`timeout` kills a hang, which then fails the test).
+CliResult rtcost(const std::string& args, int seconds = 60) {
+    const fs::path d = dir();
+    const std::string cmd = "timeout " + std::to_string(seconds) + " " + RTCOST_CLI + " " + args + " > " +
+                            (d / "out").string() + " 2> " + (d / "err").string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(d / "out"), slurp(d / "err")};
+}
+
+fs::path file(const std::string& name, const std::string& bytes) {
+    fs::path p = dir() / name;
+    std::ofstream(p, std::ios::binary) << bytes;
+    return p;
+}
+
+bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
+
+// Exit 2 with "rtcost: error: ..." (or CLI11's message for an option) saying `says`.
+void expect_bad_input(const CliResult& r, const std::string& says, int line) {
+    EXPECT_EQ(r.code, 2) << "line " << line << ": " << r.err;
+    EXPECT_TRUE(has(r.err, "rtcost: error: ") || has(r.err, "--")) << "line " << line << ": " << r.err;
+    EXPECT_TRUE(has(r.err, says)) << "line " << line << ": wanted '" << says << "' in: " << r.err;
+}
+#define EXPECT_BAD_INPUT(run, says) expect_bad_input((run), (says), __LINE__)
+
+TEST(ReliabilityCli, CountSizeAndThreadsAreValidatedClearly) {
+    EXPECT_BAD_INPUT(rtcost("trace builtin:tetra:2 --rays lines --count -1"), "--count");
+    EXPECT_BAD_INPUT(rtcost("trace builtin:tetra:2 --rays lines --count 99999999999999999999"), "--count");
+    EXPECT_BAD_INPUT(rtcost("trace builtin:tetra:2 --rays camera --size 65536x65536"), "4294967296 rays");
+    CliResult r = rtcost("trace builtin:tetra:2 -H bvh-sah --rays lines --count 100 --threads 1000 --json");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_FALSE(has(r.out, "\"threads\": 1000")) << r.out;
+    EXPECT_BAD_INPUT(rtcost("eval builtin:tetra:2 -H bvh-sah --rays camera --size 1x1 --estimator sampled"),
+                     "training and test rays");
+}
+
+TEST(ReliabilityCli, RayFileThatIsADirectoryIsNamed) {
+    const std::string d = dir().string();
+    EXPECT_BAD_INPUT(rtcost("trace builtin:tetra:2 --rays " + d), d + ": is a directory");
+}
+
+TEST(ReliabilityCli, OutputsOntoDevicesLinksAndDirectories) {
+    CliResult r = rtcost("trace builtin:tetra:2 -H bvh-sah --rays lines --count 100 --hits /dev/null -q");
+    EXPECT_EQ(r.code, 0) << r.err;
+    struct stat st{};
+    ASSERT_EQ(::stat("/dev/null", &st), 0);
+    EXPECT_TRUE(S_ISCHR(st.st_mode)) << "/dev/null was replaced";
+    if (fs::exists("/dev/full")) EXPECT_BAD_INPUT(rtcost("rays builtin:tetra:2 --dist lines --count 5000 --out /dev/full"), "/dev/full");
+    // A link: the file it points to is written, the link stays.
+    const fs::path target = file("hits.target", "old"), link = dir() / "hits.link";
+    fs::remove(link);
+    fs::create_symlink(target, link);
+    r = rtcost("trace builtin:tetra:2 -H bvh-sah --rays lines --count 100 -q --hits " + link.string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::is_symlink(link));
+    EXPECT_EQ(fs::file_size(target), 800u);
+    // A directory: exit 2 naming it, before any work.
+    const std::string d = dir().string();
+    EXPECT_BAD_INPUT(rtcost("trace builtin:tetra:2 --rays lines --count 100 --hits " + d), d + ": is a directory");
+    EXPECT_BAD_INPUT(rtcost("render builtin:tetra:2 --size 8x8 -o " + d), d + ": is a directory");
+    EXPECT_BAD_INPUT(rtcost("rays builtin:tetra:2 --dist lines --count 10 --out " + d), d + ": is a directory");
+    EXPECT_BAD_INPUT(rtcost("calibrate builtin:tetra:2 -H bvh-sah -o " + d), d + ": is a directory");
+}
+
+TEST(ReliabilityCli, PlyWithoutEndHeaderEndsWithAnError) {
+    const fs::path p = file("noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
+                                         "property float y\nproperty float z\n0 0 0\n1 0 0\n0 1 0\n");
+    EXPECT_BAD_INPUT(rtcost("info " + p.string(), 20), "end_header");
+}
+
+TEST(ReliabilityCli, PlyAndOffCountsAndIndicesAreChecked) {
+    auto ply = [](int v, const std::string& body) {
+        return "ply\nformat ascii 1.0\nelement vertex " + std::to_string(v) +
+               "\nproperty float x\nproperty float y\nproperty float z\nelement face 1\n"
+               "property list uchar int vertex_indices\nend_header\n" + body;
+    };
+    const std::string verts = "0 0 0\n1 0 0\n0 1 0\n";
+    EXPECT_EQ(rtcost("info -q " + file("ok.ply", ply(3, verts + "3 0 1 2\n")).string()).code, 0);
+    EXPECT_BAD_INPUT(rtcost("info " + file("idx.ply", ply(3, verts + "3 0 1 7\n")).string()), "refers to vertex '7'");
+    EXPECT_BAD_INPUT(rtcost("info " + file("count.ply", ply(5, verts + "3 0 1 2\n")).string()), "file ends");
+    EXPECT_EQ(rtcost("info -q " + file("ok.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()).code, 0);
+    EXPECT_BAD_INPUT(rtcost("info " + file("idx.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 3\n").string()),
+                     "refers to vertex '3'");
+    EXPECT_BAD_INPUT(rtcost("info " + file("count.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()),
+                     "declares 1 faces");
+}
+
+TEST(ReliabilityCli, FormerHangsEnd) {
+    // Lines through a flat scene (one axis-aligned triangle).
+    const fs::path flat = file("flat.nff", "p 3\n0 0 0\n1 0 0\n0 1 0\n");
+    CliResult r = rtcost("trace " + flat.string() + " -H bvh-sah --rays lines --count 1000 --json", 30);
+    EXPECT_EQ(r.code, 0) << r.err;
+    // rc5d eager without a cap is refused; with a small cap it stops and says so.
+    EXPECT_BAD_INPUT(rtcost("build builtin:balls:2 -H rc5d --set build=eager --set max_bytes=0", 30), "max_bytes");
+    r = rtcost("build builtin:balls:2 -H rc5d --set build=eager --set max_bytes=100000 --json", 30);
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(has(r.err, "rtcost: warning: rc5d: subdivision stopped at the memory cap")) << r.err;
+    EXPECT_TRUE(has(r.out, "\"limits\"")) << r.out;
+}
+
+TEST(ReliabilityCli, LimitsAreStatedAtLoad) {
+    EXPECT_BAD_INPUT(rtcost("info " + file("far.nff", "s 1e20 0 0 1\n").string()), "1e+12");
+    EXPECT_BAD_INPUT(rtcost("info " + file("small.nff", "s 0 0 0 1e-20\n").string()), "below 1e-12");
+    CliResult r = rtcost("info " + file("deg.nff", "s 0 0 0 0\n").string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(has(r.err, "degenerate sphere")) << r.err;
+}
+
+}  // namespace
