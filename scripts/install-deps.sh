@@ -11,6 +11,9 @@ packages=(
   libcli11-dev nlohmann-json3-dev libfmt-dev
   libpng-dev libstb-dev              # images
   libgtest-dev libgmock-dev libbenchmark-dev
+  pybind11-dev python3-dev           # the Python module (Debian's /usr/bin/python3)
+  python3-numpy python3-pandas python3-pytest
+  python3-dask python3-distributed   # sweeps
 )
 
 missing=()

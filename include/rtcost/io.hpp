@@ -36,6 +36,10 @@ std::vector<std::string> builtin_scene_names();
 /// Reads a whole ray file; throws InputError when its size is not a multiple of 32 bytes, or a
 /// record has a NaN, an infinite origin or direction, a zero direction, or tmin > tmax.
 std::vector<Ray> read_rays(const std::string& path);
+/// What is wrong with a ray record by the rules read_rays applies ("origin is not finite",
+/// "tmin > tmax", ...), or nullptr when it is a valid ray. Rays from any source (the Python
+/// module's arrays) are checked by the same rules.
+const char* ray_problem(const Ray& r);
 /// Writes rays atomically (to a temporary file renamed into place).
 void write_rays(const std::string& path, std::span<const Ray> rays);
 

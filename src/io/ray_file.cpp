@@ -46,17 +46,20 @@ std::vector<Ray> read_rays(const std::string& path) {
         r.d = {f[3], f[4], f[5]};
         r.tmin = f[6];
         r.tmax = f[7];
-        auto bad = [&](const std::string& what) {
+        if (const char* what = ray_problem(r))
             throw InputError(path, 0, "ray " + std::to_string(i) + " (byte " + std::to_string(i * kRecord) + "): " + what);
-        };
-        if (!is_finite(r.o)) bad("origin is not finite");
-        if (!is_finite(r.d)) bad("direction is not finite");
-        if (r.d == Vec3{0, 0, 0}) bad("direction is zero");
-        if (std::isnan(r.tmin) || std::isnan(r.tmax)) bad("tmin or tmax is NaN");
-        if (r.tmin == kInf) bad("tmin is +inf");
-        if (r.tmin > r.tmax) bad("tmin > tmax");
     }
     return rays;
+}
+
+const char* ray_problem(const Ray& r) {
+    if (!is_finite(r.o)) return "origin is not finite";
+    if (!is_finite(r.d)) return "direction is not finite";
+    if (r.d == Vec3{0, 0, 0}) return "direction is zero";
+    if (std::isnan(r.tmin) || std::isnan(r.tmax)) return "tmin or tmax is NaN";
+    if (r.tmin == kInf) return "tmin is +inf";
+    if (r.tmin > r.tmax) return "tmin > tmax";
+    return nullptr;
 }
 
 void write_file_atomic(const std::string& path, std::string_view bytes) {
