@@ -175,7 +175,7 @@ def _client(scheduler, workers):
     if scheduler:
         return Client(scheduler), None
     cluster = LocalCluster(n_workers=int(workers or os.cpu_count() or 1), threads_per_worker=1, processes=True,
-                           dashboard_address=None)
+                           dashboard_address=":0")
     return Client(cluster), cluster
 
 

@@ -30,7 +30,7 @@ def without_times(value):
 @pytest.fixture(scope="module")
 def cluster():
     from dask.distributed import LocalCluster
-    c = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None)
+    c = LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0")
     yield c
     c.close()
 
