@@ -105,6 +105,8 @@ void bind_hierarchy(pb::module_& m) {
 
     pb::class_<PyHierarchy>(m, "Hierarchy", "An acceleration structure built over a scene (Scene.build).")
         .def_property_readonly("name", [](const PyHierarchy& ph) { return std::string(ph.h->name()); })
+        .def_property_readonly("_assignments", [](const PyHierarchy& ph) { return ph.set; },
+                               "the `key=value` assignments it was built with")
         .def_property_readonly("params", [](const PyHierarchy& ph) { return to_python(params_json(ph)); },
                                "every parameter's value, defaults included")
         .def(

@@ -36,6 +36,8 @@ def test_rays_are_the_cli_ray_file(scene, tmp_path):
     path = tmp_path / "lines.rays"
     run_cli("rays", SCENE, "--dist", "lines", "--count", 3000, "--seed", 5, "--out", path)
     assert np.array_equal(np.fromfile(path, dtype="<f4").reshape(-1, 8), r.rays)
+    from_file = rtcost.rays(scene, str(path))
+    assert np.array_equal(from_file.rays, r.rays) and set(from_file.kinds) == {rtcost.RAY_KINDS.index("file")}
     cam = rtcost.rays(scene, "camera", size="16x8")
     assert cam.rays.shape == (128, 8) and cam.described == "camera 16x8"
 
