@@ -119,21 +119,29 @@ def run_job(job):
         result = h.trace(rays, query=job["query"], threads=job["threads"])
         row.update(status="ok", primitives=scene.primitives, rays=result.rays, hits=result.hits,
                    seconds=result.seconds, structure=h.structure(), per_ray=result.counters)
-        row["model"] = _predict(scene, h, rays, job)
+        row["model"] = _predict(scene, job)
     except Exception as e:  # a job's failure is its row, so that the others go on
         row.update(status="error", error=str(e), error_type=type(e).__name__)
     return row
 
 
-def _predict(scene, h, rays, job):
-    """The model's prediction beside the measurement, through rtcost.evaluate when there is one."""
+def _predict(scene, job):
+    """The job's row of `rtcost eval --json` (predicted beside measured cost) for the same
+    hierarchy, parameters and rays: rtcost.evaluate with the job's estimator and preset."""
     import rtcost
-    try:
-        from . import _evaluate  # noqa: F401
-    except ImportError:
+    from . import _rtcost
+    if not hasattr(_rtcost, "_evaluate"):
         return None
-    return rtcost.evaluate(scene, [h], rays, estimator=job["estimator"], preset=job["preset"],
-                           query=job["query"], table=False)
+    d = job["dist"]
+    label = ":".join([job["hierarchy"], *(f"{k}={_text(v)}" for k, v in sorted(job["params"].items()))])
+    doc = rtcost.evaluate(scene, [label], d["dist"], size=d.get("size"), count=d.get("count", 100000),
+                          seed=d.get("seed", 1), estimator=job["estimator"], preset=job["preset"],
+                          query=job["query"], threads=job["threads"], table=False)
+    return doc["results"][0]
+
+
+def _text(v):
+    return ("1" if v else "0") if isinstance(v, bool) else str(v)
 
 
 def _read_done(out):
@@ -292,8 +300,8 @@ def _print_table(rows):
             print(f"{head} error: {r['error']}")
             continue
         pr, model = r["per_ray"], r.get("model") or {}
-        pred = model.get("predicted")
-        meas = model.get("measured")
+        pred = (model.get("predicted") or {}).get("cost")
+        meas = (model.get("measured") or {}).get("cost")
         print(f"{head} {pr['N_IT']:>9.3f} {pr['N_TS']:>9.3f} "
               f"{'' if pred is None else f'{pred:.3f}':>10} {'' if meas is None else f'{meas:.3f}':>10}")
 
