@@ -14,7 +14,11 @@ pb::tuple vec(Vec3 v) { return pb::make_tuple(v.x, v.y, v.z); }
 /// make_rays without the GIL; returns (rays (N, 8) float32, kinds (N,) uint8, described).
 pb::tuple make_rays_py(const Scene& scene, const std::string& dist, const std::string& size, std::size_t count,
                        std::uint64_t seed) {
-    RaySpec spec{dist, size, count, seed};
+    RaySpec spec;
+    spec.name = dist;
+    spec.size = size;
+    spec.count = count;
+    spec.seed = seed;
     RaySet set;
     {
         pb::gil_scoped_release release;
