@@ -62,8 +62,7 @@ int cmd_trace(const TraceArgs& a, const Common& common) {
             by_kind[std::string(ray_kind_name(static_cast<RayKind>(k)))] = e;
         }
         trace["by_kind"] = by_kind;
-        if (kinds.size() > 1 || (kinds.size() == 1 && (kinds[0] == static_cast<int>(RayKind::Shadow) ||
-                                                       kinds[0] == static_cast<int>(RayKind::AO))))
+        if (kinds.size() > 1 || (kinds.size() == 1 && is_occlusion(static_cast<RayKind>(kinds[0]))))
             trace["shadow_query"] = a.shadow;
         if (counted) trace["per_ray"] = per_ray_json(counted->counters);
         json j = {{"scene", scene.name}, {"primitives", scene.size()}, {"hierarchy", h->name()},

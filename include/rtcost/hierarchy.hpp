@@ -71,6 +71,9 @@ struct ModelFlags {
     /// A closest-hit query skips what lies beyond the nearest hit found so far (false: the
     /// traversal visits everything the segment meets, e.g. a BVH with `order=none`).
     bool cull = true;
+    /// A ray that misses the root's region ends at the root test (false: every ray enters the
+    /// root whatever it meets, as brute force's does).
+    bool gated = true;
 };
 
 /// A hierarchy flattened for the model: `nodes[0]` is the root; the children of a node are

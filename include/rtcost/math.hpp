@@ -135,4 +135,22 @@ inline float box_entry(const Box3& b, const RayInv& r, float tmin, float tmax) {
     return t0 <= t1 ? t0 : kInf;
 }
 
+/// A segment of a ray by its parameter, [t0, t1]; empty when t0 > t1 (or NaN).
+struct Segment {
+    float t0, t1;
+    bool empty() const { return !(t0 <= t1); }
+};
+
+/// `s` clipped to box `b` (no widening: the model's probes, not the traversals' hit tests).
+inline Segment clip_segment(const RayInv& ri, const Box3& b, Segment s) {
+    for (int k = 0; k < 3; ++k) {
+        float tn = (b.lo[k] - ri.o[k]) * ri.inv[k], tf = (b.hi[k] - ri.o[k]) * ri.inv[k];
+        if (tn > tf) std::swap(tn, tf);
+        // NaN (0 * inf: a ray in a face's plane) fails both compares and is ignored.
+        s.t0 = tn > s.t0 ? tn : s.t0;
+        s.t1 = tf < s.t1 ? tf : s.t1;
+    }
+    return s;
+}
+
 }  // namespace rtcost

@@ -25,6 +25,9 @@ struct CostVector {
     double prim_tests() const { return prim[0] + prim[1] + prim[2] + prim[3]; }
 };
 
+/// y += w x, field by field.
+void add_scaled(CostVector& y, const CostVector& x, double w);
+
 /// Cost of one operation of each kind (default 1: pure operation counts; calibrated: ns).
 struct UnitCosts {
     double box = 1, plane = 1, hop = 1, classify = 1;
@@ -73,6 +76,7 @@ enum class Preset {
 enum class Estimator {
     Geometric,  ///< surface-area (Cauchy-Crofton) probabilities for isotropic lines; no rays traced
     Sampled,    ///< probabilities counted from a training sample of rays
+    Segments,   ///< probabilities from a ray sample's ended segments (sample.hpp): no primitive tests
 };
 
 struct ModelOptions {
@@ -89,6 +93,7 @@ struct Prediction {
     std::string estimator, preset;
     /// How P over several primitives was approximated (geometric estimator).
     std::string note;
+    double seconds = 0;  ///< time the prediction took (set by evaluate)
 };
 
 /// Geometric estimator: probabilities from surface areas of each node's entry region for
@@ -111,5 +116,15 @@ Prediction predict_geometric(const Hierarchy& h, const ModelOptions& opt, const 
 /// of the same distribution it errs by the sample's noise.
 Prediction predict_sampled(const ModelTree& tree, const Scene& scene, std::span<const Ray> training,
                            const ModelOptions& opt, const UnitCosts& costs = {});
+
+struct RaySample;
+
+/// Segments estimator: the same probe and recursion as predict_sampled, but the probe learns
+/// where each ray's search ends from the sample's known crossings (sample.hpp) instead of
+/// testing primitives, so one sample, drawn once per scene and distribution, predicts any
+/// hierarchy over the scene. `rays` are the sample's indices to use (e.g. those of one kind,
+/// traced with opt.query). Throws InputError for a sample of another scene.
+Prediction predict_segments(const ModelTree& tree, const Scene& scene, const RaySample& sample,
+                            std::span<const std::uint32_t> rays, const ModelOptions& opt, const UnitCosts& costs = {});
 
 }  // namespace rtcost

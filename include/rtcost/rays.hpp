@@ -33,6 +33,9 @@ std::vector<Ray> random_rays(const Box3& box, std::size_t n, std::uint64_t seed)
 enum class RayKind : std::uint8_t { Eye, Reflection, Refraction, Shadow, Diffuse, AO, Line, Test, File };
 inline constexpr int kRayKinds = 9;
 std::string_view ray_kind_name(RayKind k);
+/// Whether rays of `kind` are occlusion queries (shadow and ambient-occlusion rays): traced
+/// any-hit unless asked otherwise.
+bool is_occlusion(RayKind kind);
 
 /// A batch of rays with their kinds. Shadow and ambient-occlusion rays are occlusion queries
 /// (any hit) unless traced otherwise.

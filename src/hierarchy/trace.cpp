@@ -80,8 +80,7 @@ TraceResult trace_ray_set(const Hierarchy& h, const RaySet& set, const TraceOpti
         batch.reserve(index[k].size());
         for (std::size_t i : index[k]) batch.push_back(set.rays[i]);
         TraceOptions o = opt;
-        RayKind kind = static_cast<RayKind>(k);
-        if (kind == RayKind::Shadow || kind == RayKind::AO) o.query = occlusion;
+        if (is_occlusion(static_cast<RayKind>(k))) o.query = occlusion;
         if (opt.progress) o.progress = [&](std::size_t d) { opt.progress(before + d); };
         TraceResult r = trace_rays(h, batch, o);
         for (std::size_t j = 0; j < batch.size(); ++j) res.hits[index[k][j]] = r.hits[j];

@@ -1,29 +1,12 @@
 #include <charconv>
 #include <cmath>
 #include <numbers>
-#include <random>
 
 #include "rtcost/error.hpp"
 #include "rtcost/rays.hpp"
+#include "util/rng.hpp"
 
 namespace rtcost {
-namespace {
-
-// mt19937_64 is specified bit-exactly by the standard; the standard distributions are not, so
-// uniform doubles are made from the raw 53 bits here to keep rays identical across libraries.
-struct Rng {
-    std::mt19937_64 engine;
-    explicit Rng(std::uint64_t seed) : engine(seed) {}
-    double uniform() { return static_cast<double>(engine() >> 11) * 0x1p-53; }
-    Vec3 direction() {
-        double z = 1 - 2 * uniform();
-        double phi = 2 * std::numbers::pi * uniform();
-        double r = std::sqrt(std::max(0.0, 1 - z * z));
-        return {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
-    }
-};
-
-}  // namespace
 
 std::vector<Ray> camera_rays(const Camera& cam, int width, int height) {
     Vec3 fwd = normalize(cam.at - cam.from);

@@ -25,6 +25,8 @@ std::string_view ray_kind_name(RayKind k) {
     return "?";
 }
 
+bool is_occlusion(RayKind kind) { return kind == RayKind::Shadow || kind == RayKind::AO; }
+
 std::vector<std::string> distribution_names() { return {"camera", "spd", "shadow", "diffuse", "ao", "lines", "random"}; }
 
 namespace {

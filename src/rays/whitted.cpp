@@ -14,6 +14,7 @@
 
 #include "rtcost/error.hpp"
 #include "rtcost/trace.hpp"
+#include "util/rng.hpp"
 
 namespace rtcost {
 
@@ -146,21 +147,7 @@ RayTree join(std::vector<Recorder>& rows, bool record) {
     return tree;
 }
 
-// splitmix64 (Steele, Lea and Flood): a tiny, well-mixed generator whose whole state is one
-// word, so every pixel gets its own stream from (seed, pixel) independently of the threads.
-struct PixelRng {
-    std::uint64_t state;
-    PixelRng(std::uint64_t seed, std::uint64_t pixel) : state(seed * 0x9e3779b97f4a7c15ull ^ (pixel + 1) * 0xd1b54a32d192ed03ull) {
-        next();
-    }
-    std::uint64_t next() {
-        std::uint64_t z = (state += 0x9e3779b97f4a7c15ull);
-        z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ull;
-        z = (z ^ (z >> 27)) * 0x94d049bb133111ebull;
-        return z ^ (z >> 31);
-    }
-    double uniform() { return static_cast<double>(next() >> 11) * 0x1p-53; }
-};
+using PixelRng = ItemRng;  // one stream per pixel
 
 // Cosine-weighted direction about unit `n` (Malley's method: uniform on the disc, projected up).
 Vec3 cosine_direction(Vec3 n, PixelRng& rng) {

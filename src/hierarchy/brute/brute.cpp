@@ -29,6 +29,7 @@ public:
         ModelFlags f;
         f.family = "bvh";
         f.per_ray_box = 0;
+        f.gated = false;  // a ray that misses the scene's box still tests every primitive
         if (!sink.begin(f)) return true;
         std::vector<std::uint32_t> ids(scene_->size());
         for (std::uint32_t id = 0; id < ids.size(); ++id) ids[id] = id;

@@ -7,9 +7,9 @@
 // Cost, in units of area (probability of a ray meeting a box is proportional to its area):
 // every child box of an interior node N is tested when N is entered (area(N) each), and every
 // primitive of a leaf L when L is entered (area(L) each).
-#include <random>
 
 #include "bvh.hpp"
+#include "util/rng.hpp"
 
 namespace rtcost::bvh {
 namespace {
@@ -153,9 +153,9 @@ BvhData build_gs(const Scene& s, const GsOptions& o) {
     std::vector<std::uint32_t> order(s.size());
     for (std::uint32_t i = 0; i < s.size(); ++i) order[i] = i;
     if (o.seed != 0) {
-        // Fisher-Yates on mt19937_64's raw output: the same order on every standard library.
-        std::mt19937_64 rng(o.seed);
-        for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng() % i]);
+        // Fisher-Yates on the raw output: the same order on every standard library.
+        Rng rng(o.seed);
+        for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.engine() % i]);
     }
     GsTree tree(info, o);
     for (std::uint32_t id : order) tree.insert(id);

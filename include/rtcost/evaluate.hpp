@@ -1,0 +1,120 @@
+#pragma once
+/// \file evaluate.hpp
+/// The evaluation rtcost exists for: hierarchies built over one scene, each one's cost per ray
+/// predicted by the model and measured on the same rays, side by side and ranked. `rtcost eval`
+/// is this call plus printing; the report, the design command and the Python module call it too.
+
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "rtcost/hierarchy.hpp"
+#include "rtcost/model.hpp"
+#include "rtcost/rays.hpp"
+#include "rtcost/stats.hpp"
+
+namespace rtcost {
+
+/// One hierarchy to evaluate: a registered name and its `key=value` parameters.
+struct HierarchyRequest {
+    std::string name;
+    std::vector<std::string> params;
+    /// "name" or "name:key=value[:key=value...]".
+    std::string label() const;
+};
+
+/// Parses a hierarchy list: "all", or comma-separated "name[:key=value[:key=value...]]" (e.g.
+/// "bvh-gs:seed=1,octree:max_depth=6,grid"). "all" is every registered hierarchy that makes
+/// sense over `primitives` primitives (no embree; no brute above kBruteLimit primitives).
+/// Throws InputError naming `what` for an unknown name or a malformed entry.
+std::vector<HierarchyRequest> parse_hierarchy_list(std::string_view list, std::size_t primitives,
+                                                   const std::string& what = "--hierarchy");
+
+/// Above this many primitives `all` leaves brute force out (ask for it by name).
+inline constexpr std::size_t kBruteLimit = 5000;
+
+struct EvalRow;
+
+/// What to evaluate and how.
+struct EvalOptions {
+    std::vector<HierarchyRequest> hierarchies;
+    /// Estimators and presets to evaluate; the first of each gives the headline prediction.
+    std::vector<Estimator> estimators{Estimator::Sampled};
+    std::vector<Preset> presets{Preset::Exact};
+    Query query = Query::Closest;      ///< every ray kind but the occlusion ones
+    Query occlusion = Query::Any;      ///< shadow and ambient-occlusion rays
+    std::size_t sample = 20000;        ///< training rays at most (sampled estimator)
+    /// Segments estimator: rays in the sample drawn from the distribution (0: 2% of the rays,
+    /// at most 4,096 and at least 256 where there are four times as many), its seed, or a
+    /// sample file (`rtcost sample`) instead.
+    std::size_t segments = 0;
+    std::uint64_t sample_seed = 1;
+    std::string sample_file;
+    UnitCosts costs;                   ///< unit costs (calibrated: ns) for the scalar cost
+    int threads = 0;                   ///< 0: all cores (1 when the costs are calibrated)
+    /// Called before each hierarchy is built ("building NAME"), and with each finished row.
+    std::function<void(const std::string& step)> on_step;
+    std::function<void(const EvalRow& row)> on_row;
+};
+
+/// One hierarchy's evaluation.
+struct EvalRow {
+    std::string name;                  ///< HierarchyRequest::label()
+    StructureStats structure;
+    bool modelled = false;             ///< the model sees into it (not embree)
+    bool lazy = false;                 ///< grown by the rays (rc5d's default)
+    std::vector<Prediction> predictions;  ///< every estimator x preset asked for; [0] the headline
+    CostVector measured;               ///< counted operations per ray
+    double measured_scalar = 0;        ///< measured operations in unit costs
+    double error = 0;                  ///< (headline - measured) / measured
+    double mrays_per_s = 0;            ///< measured speed on `threads` threads
+    double ns_per_ray = 0;             ///< measured wall time per ray x threads
+    int threads = 1;
+    std::vector<double> measured_visits;  ///< measured traversal steps per depth per ray
+    int rank_predicted = 0, rank_measured = 0;  ///< 1 = cheapest (0: not ranked)
+
+    const Prediction* headline() const { return predictions.empty() ? nullptr : &predictions.front(); }
+};
+
+/// Everything `rtcost eval` reports.
+struct EvalResult {
+    std::string scene;
+    std::size_t primitives = 0;
+    std::string distribution;          ///< RaySet::described
+    std::size_t test_rays = 0, training_rays = 0;
+    std::size_t sample_rays = 0;       ///< the segments estimator's sample (disjoint from the test rays)
+    double sample_seconds = 0;         ///< drawing it (once for every hierarchy)
+    /// How the rays were split: "none", "fresh draw" (lines, random), "pseudo-random half", or
+/// "sample" (the segments estimator's sample left out of the test rays).
+    std::string split;
+    Query query = Query::Closest, occlusion = Query::Any;
+    std::vector<std::pair<std::string, std::size_t>> rays_by_kind;  ///< test rays per kind
+    std::vector<Estimator> estimators;
+    std::vector<Preset> presets;
+    bool calibrated = false;
+    std::vector<EvalRow> rows;
+};
+
+/// Evaluates `opt.hierarchies` over `scene` on the rays `spec` names. With the sampled
+/// estimator the training rays are disjoint from the test rays: a fresh draw with another seed
+/// for random distributions, otherwise a pseudo-random half of the rays, thinned to `sample`.
+/// Throws InputError for bad requests.
+EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& opt);
+/// The same on a given ray set (e.g. rays from a file or from Python): the training rays are a
+/// pseudo-random half of `rays`.
+EvalResult evaluate(const Scene& scene, RaySet rays, const EvalOptions& opt);
+
+/// The `rtcost eval --json` document of `r` (with `visits_by_depth` when `by_depth`).
+nlohmann::json to_json(const EvalResult& r, bool by_depth = false);
+/// The text tables `rtcost eval` prints (with visits per depth when `by_depth`).
+std::string eval_table(const EvalResult& r, bool by_depth = false);
+
+std::string_view estimator_name(Estimator e);
+std::string_view preset_name(Preset p);
+std::string_view query_name(Query q);
+
+}  // namespace rtcost

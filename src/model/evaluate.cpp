@@ -1,0 +1,328 @@
+// The evaluation: build each requested hierarchy, trace the test rays counted and timed, predict
+// with every estimator and preset asked for, and rank. `rtcost eval` prints what this returns.
+#include "rtcost/evaluate.hpp"
+
+#include <algorithm>
+#include <array>
+#include <chrono>
+#include <map>
+#include <optional>
+
+#include "rtcost/error.hpp"
+#include "rtcost/sample.hpp"
+#include "rtcost/trace.hpp"
+#include "util/rng.hpp"
+
+namespace rtcost {
+
+std::string_view estimator_name(Estimator e) {
+    switch (e) {
+        case Estimator::Geometric: return "geometric";
+        case Estimator::Sampled: return "sampled";
+        case Estimator::Segments: return "segments";
+    }
+    return "?";
+}
+
+std::string_view preset_name(Preset p) { return p == Preset::Paper ? "paper" : "exact"; }
+
+std::string_view query_name(Query q) {
+    switch (q) {
+        case Query::Closest: return "closest";
+        case Query::Any: return "any";
+        case Query::All: return "all";
+    }
+    return "?";
+}
+
+std::string HierarchyRequest::label() const {
+    std::string out = name;
+    for (const std::string& p : params) out += ":" + p;
+    return out;
+}
+
+std::vector<HierarchyRequest> parse_hierarchy_list(std::string_view list, std::size_t primitives,
+                                                   const std::string& what) {
+    std::vector<HierarchyRequest> out;
+    if (list == "all") {
+        for (const HierarchyInfo* h : hierarchies()) {
+            if (h->name == "embree") continue;
+            if (h->name == "brute" && primitives > kBruteLimit) continue;
+            out.push_back({h->name, {}});
+        }
+        return out;
+    }
+    std::size_t start = 0;
+    while (start <= list.size()) {
+        std::size_t comma = list.find(',', start);
+        if (comma == std::string_view::npos) comma = list.size();
+        std::string_view entry = list.substr(start, comma - start);
+        start = comma + 1;
+        if (entry.empty()) continue;
+        HierarchyRequest r;
+        std::size_t colon = entry.find(':');
+        r.name = std::string(entry.substr(0, colon));
+        while (colon != std::string_view::npos) {
+            std::size_t next = entry.find(':', colon + 1);
+            std::string_view p = entry.substr(colon + 1, next == std::string_view::npos ? next : next - colon - 1);
+            if (p.find('=') == std::string_view::npos || p.front() == '=')
+                throw InputError(what, 0, "'" + std::string(entry) + "': parameters are name:key=value");
+            r.params.emplace_back(p);
+            colon = next;
+        }
+        if (!find_hierarchy(r.name)) {
+            std::string names;
+            for (const HierarchyInfo* h : hierarchies()) names += (names.empty() ? "" : ", ") + h->name;
+            throw InputError(what, 0, "unknown hierarchy '" + r.name + "' (known: " + names + ")");
+        }
+        out.push_back(std::move(r));
+    }
+    if (out.empty()) throw InputError(what, 0, "no hierarchy named");
+    return out;
+}
+
+namespace {
+
+/// Weighted mean of per-kind predictions (weights: the kinds' shares of the rays).
+Prediction mix(const std::vector<std::pair<double, Prediction>>& parts, const UnitCosts& costs) {
+    if (parts.size() == 1) return parts[0].second;
+    Prediction out = parts.at(0).second;
+    out.cost = CostVector{};
+    out.visits_by_depth.clear();
+    out.seconds = 0;
+    for (const auto& [w, p] : parts) {
+        add_scaled(out.cost, p.cost, w);
+        if (out.visits_by_depth.size() < p.visits_by_depth.size()) out.visits_by_depth.resize(p.visits_by_depth.size());
+        for (std::size_t d = 0; d < p.visits_by_depth.size(); ++d) out.visits_by_depth[d] += w * p.visits_by_depth[d];
+        out.seconds += p.seconds;
+    }
+    out.scalar = costs.scalar(out.cost);
+    return out;
+}
+
+/// Ranks 1..n by ascending value; rows whose value is not finite are not ranked (0).
+template <class F>
+void rank(std::vector<EvalRow>& rows, F value, int EvalRow::*out) {
+    std::vector<std::size_t> idx;
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+        if (std::isfinite(value(rows[i]))) idx.push_back(i);
+        else rows[i].*out = 0;
+    }
+    std::stable_sort(idx.begin(), idx.end(), [&](auto x, auto y) { return value(rows[x]) < value(rows[y]); });
+    for (std::size_t r = 0; r < idx.size(); ++r) rows[idx[r]].*out = static_cast<int>(r + 1);
+}
+
+std::array<std::vector<Ray>, kRayKinds> by_kind(const RaySet& s) {
+    std::array<std::vector<Ray>, kRayKinds> out;
+    for (std::size_t i = 0; i < s.rays.size(); ++i) out[static_cast<int>(s.kinds[i])].push_back(s.rays[i]);
+    return out;
+}
+
+/// A pseudo-random half of `all` for training (thinned to `sample`), the rest for testing. Not
+/// every other ray: a ray tree's order (eye, a shadow ray per light, reflection, ...) would put
+/// one light's shadow rays in training and another's in test.
+void split_half(RaySet& all, RaySet& train, std::size_t sample) {
+    RaySet keep;
+    const std::size_t half = all.rays.size() / 2;
+    const double keep_share = half > sample ? static_cast<double>(sample) / half : 1.0;
+    for (std::size_t i = 0; i < all.rays.size(); ++i) {
+        const std::uint64_t z = mix64(i + 1);
+        const bool to_train = z & 1;  // one bit picks the side, the rest thin
+        if (to_train && unit_double(z) >= keep_share) continue;
+        RaySet& to = to_train ? train : keep;
+        to.rays.push_back(all.rays[i]);
+        to.kinds.push_back(all.kinds[i]);
+    }
+    keep.described = all.described;
+    all = std::move(keep);
+}
+
+bool wants(const EvalOptions& opt, Estimator e) {
+    return std::find(opt.estimators.begin(), opt.estimators.end(), e) != opt.estimators.end();
+}
+
+EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySample* sample, const EvalOptions& opt,
+               std::string split) {
+    if (opt.hierarchies.empty()) throw InputError("--hierarchy", 0, "no hierarchy named");
+    if (opt.estimators.empty() || opt.presets.empty()) throw InputError("--estimator", 0, "no estimator or preset");
+    if (test.rays.empty()) throw InputError("--rays", 0, "no test rays");
+    const bool sampled = wants(opt, Estimator::Sampled);
+    const UnitCosts& costs = opt.costs;
+    auto query_of = [&](int k) { return is_occlusion(static_cast<RayKind>(k)) ? opt.occlusion : opt.query; };
+    const auto test_kinds = by_kind(test), train_kinds = by_kind(train);
+    if (sampled)
+        for (int k = 0; k < kRayKinds; ++k)
+            if (!test_kinds[k].empty() && train_kinds[k].empty())
+                throw InputError("--sample", 0,
+                                 "no training rays of kind " + std::string(ray_kind_name(static_cast<RayKind>(k))) +
+                                     ": too few rays to split (" + std::to_string(test.rays.size()) + ")");
+
+    EvalResult res;
+    res.scene = scene.name;
+    res.primitives = scene.size();
+    res.distribution = test.described;
+    res.test_rays = test.rays.size();
+    res.training_rays = train.rays.size();
+    std::array<std::vector<std::uint32_t>, kRayKinds> sample_kinds;
+    if (sample) {
+        res.sample_rays = sample->size();
+        for (std::size_t i = 0; i < sample->size(); ++i)
+            sample_kinds[static_cast<int>(sample->rays.kinds[i])].push_back(static_cast<std::uint32_t>(i));
+        for (int k = 0; k < kRayKinds; ++k)
+            if (!test_kinds[k].empty() && sample_kinds[k].empty())
+                throw InputError("--sample", 0,
+                                 "the sample has no rays of kind " + std::string(ray_kind_name(static_cast<RayKind>(k))) +
+                                     ": draw a larger one");
+    }
+    res.split = std::move(split);
+    res.query = opt.query;
+    res.occlusion = opt.occlusion;
+    for (int k = 0; k < kRayKinds; ++k)
+        if (!test_kinds[k].empty()) res.rays_by_kind.emplace_back(ray_kind_name(static_cast<RayKind>(k)), test_kinds[k].size());
+    res.estimators = opt.estimators;
+    res.presets = opt.presets;
+    res.calibrated = costs.calibrated;
+
+    for (const HierarchyRequest& req : opt.hierarchies) {
+        if (opt.on_step) opt.on_step("building " + req.label());
+        auto h = build_hierarchy(scene, req.name, req.params);
+        EvalRow row;
+        row.name = req.label();
+        TraceOptions to;
+        to.query = opt.query;
+        // With calibrated (single-thread) unit costs, time on one thread unless told otherwise.
+        to.threads = opt.threads > 0 ? opt.threads : costs.calibrated ? 1 : 0;
+        // Counted first, so a lazily built hierarchy (rc5d) is complete when timed.
+        if (opt.on_step) opt.on_step("counting " + req.label());
+        to.count = true;
+        TraceResult counted = trace_ray_set(*h, test, to, opt.occlusion);
+        if (opt.on_step) opt.on_step("timing " + req.label());
+        to.count = false;
+        TraceResult timed = trace_ray_set(*h, test, to, opt.occlusion);
+        // Structure and model tree after tracing: a lazily built hierarchy (rc5d) exists only
+        // where rays went, so the training rays go through it too.
+        if (sampled && h->lazy())
+            for (int k = 0; k < kRayKinds; ++k) trace_rays(*h, train_kinds[k]);
+        if (sample && h->lazy()) trace_rays(*h, sample->rays.rays);
+        row.structure = h->structure();
+        row.lazy = h->lazy();
+        row.modelled = h->modelled();
+        if (row.modelled) {
+            if (opt.on_step) opt.on_step("predicting " + req.label());
+            // The sampled estimator's probe indexes a materialised tree; the geometric one reads
+            // the hierarchy where it lies.
+            const bool probed = sampled || wants(opt, Estimator::Segments);
+            const auto tree_start = std::chrono::steady_clock::now();
+            const ModelTree tree = probed ? h->model_tree() : ModelTree{};
+            // Materialising the tree is part of what a probed prediction costs.
+            const double tree_seconds =
+                std::chrono::duration<double>(std::chrono::steady_clock::now() - tree_start).count();
+            for (Estimator est : opt.estimators) {
+                for (Preset preset : opt.presets) {
+                    std::vector<std::pair<double, Prediction>> parts;
+                    // The geometric estimate depends on the query, not on the rays: one per query.
+                    std::map<Query, Prediction> geometric;
+                    for (int k = 0; k < kRayKinds; ++k) {
+                        if (test_kinds[k].empty()) continue;
+                        ModelOptions o;
+                        o.preset = preset;
+                        o.query = query_of(k);
+                        const double share = static_cast<double>(test_kinds[k].size()) / test.rays.size();
+                        const auto start = std::chrono::steady_clock::now();
+                        if (est == Estimator::Sampled) {
+                            parts.emplace_back(share, predict_sampled(tree, scene, train_kinds[k], o, costs));
+                        } else if (est == Estimator::Segments) {
+                            parts.emplace_back(share, predict_segments(tree, scene, *sample, sample_kinds[k], o, costs));
+                        } else {
+                            auto it = geometric.find(o.query);
+                            if (it == geometric.end())
+                                it = geometric.emplace(o.query, predict_geometric(*h, o, costs)).first;
+                            parts.emplace_back(share, it->second);
+                        }
+                        parts.back().second.seconds =
+                            std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                    }
+                    row.predictions.push_back(mix(parts, costs));
+                    if (est != Estimator::Geometric) row.predictions.back().seconds += tree_seconds;
+                }
+            }
+        }
+        row.measured = measured_cost(counted.counters);
+        row.measured_scalar = costs.scalar(row.measured);
+        const Prediction* head = row.headline();
+        row.error = head && row.measured_scalar > 0 ? (head->scalar - row.measured_scalar) / row.measured_scalar : 0;
+        row.mrays_per_s = timed.seconds > 0 ? test.rays.size() / timed.seconds / 1e6 : 0;
+        row.ns_per_ray = timed.seconds * 1e9 * timed.threads / test.rays.size();
+        row.threads = timed.threads;
+        const double n = counted.counters.rays ? static_cast<double>(counted.counters.rays) : 1;
+        for (int d = 0; d < kMaxStatDepth; ++d) row.measured_visits.push_back(counted.counters.visits[d] / n);
+        while (!row.measured_visits.empty() && row.measured_visits.back() == 0) row.measured_visits.pop_back();
+        if (opt.on_row) opt.on_row(row);
+        res.rows.push_back(std::move(row));
+    }
+    rank(res.rows, [](const EvalRow& r) { return r.modelled ? r.headline()->scalar : kInf; }, &EvalRow::rank_predicted);
+    rank(res.rows, [](const EvalRow& r) { return r.measured_scalar; }, &EvalRow::rank_measured);
+    return res;
+}
+
+}  // namespace
+
+EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& opt) {
+    RaySet test = make_rays(scene, spec);
+    RaySet train;
+    std::optional<RaySample> sample;
+    double sample_seconds = 0;
+    std::string split = "none";
+    if (wants(opt, Estimator::Segments)) {
+        // The sample is left out of the test rays, which are every other ray of the distribution.
+        const auto start = std::chrono::steady_clock::now();
+        if (!opt.sample_file.empty()) {
+            sample = read_sample(opt.sample_file);
+            if (sample->distribution != test.described || sample->population != test.rays.size())
+                throw InputError(opt.sample_file, 0,
+                                 "the sample was drawn from '" + sample->distribution + "' (" +
+                                     std::to_string(sample->population) + " rays), the test rays are '" +
+                                     test.described + "' (" + std::to_string(test.rays.size()) + " rays)");
+        } else {
+            // By default 2% of the rays, at most 4,096, and no fewer than 256 where there are enough.
+            const std::size_t pop = test.rays.size();
+            const std::size_t n = opt.segments > 0 ? opt.segments
+                                                   : std::min<std::size_t>(4096, std::max(pop / 50, std::min<std::size_t>(256, pop / 4)));
+            if (n == 0 || n >= test.rays.size())
+                throw InputError("--segments", 0, "a sample of " + std::to_string(n) + " out of " +
+                                                      std::to_string(test.rays.size()) + " rays leaves no test rays");
+            auto reference = build_hierarchy(scene, "bvh-sah");
+            sample = draw_sample_from(scene, test, n, opt.sample_seed, *reference, opt.query, opt.occlusion);
+        }
+        test = rays_outside_sample(test, sample->size(), sample->seed);
+        sample_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        split = "sample";
+    }
+    if (wants(opt, Estimator::Sampled)) {
+        if (spec.name == "lines" || spec.name == "random") {
+            // A fresh draw of the same distribution with another seed.
+            RaySpec t = spec;
+            t.seed = spec.seed + 7919;
+            t.count = opt.sample;
+            train = make_rays(scene, t);
+            split = split == "none" ? "fresh draw" : split + " and fresh draw";
+        } else {
+            split_half(test, train, opt.sample);
+            split = split == "none" ? "pseudo-random half" : split + " and pseudo-random half";
+        }
+    }
+    EvalResult r = run(scene, std::move(test), train, sample ? &*sample : nullptr, opt, split);
+    r.sample_seconds = sample_seconds;
+    return r;
+}
+
+EvalResult evaluate(const Scene& scene, RaySet rays, const EvalOptions& opt) {
+    if (wants(opt, Estimator::Segments))
+        throw InputError("--estimator", 0, "the segments estimator needs a distribution to sample (not a ray set)");
+    RaySet train;
+    if (!wants(opt, Estimator::Sampled)) return run(scene, std::move(rays), train, nullptr, opt, "none");
+    split_half(rays, train, opt.sample);
+    return run(scene, std::move(rays), train, nullptr, opt, "pseudo-random half");
+}
+
+}  // namespace rtcost

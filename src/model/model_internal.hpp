@@ -1,0 +1,103 @@
+#pragma once
+// What the model's files share (not public API): Crofton geometry, the recursion over a
+// materialised model tree and its per-node probabilities, 5D beam weights.
+#include <array>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "rtcost/model.hpp"
+
+namespace rtcost::model {
+
+/// The cost vector's scalar fields (its `prim` array aside), for sums field by field.
+inline constexpr double CostVector::*kCostFields[] = {&CostVector::box,      &CostVector::plane, &CostVector::hop,
+                                                     &CostVector::classify, &CostVector::steps, &CostVector::leaves,
+                                                     &CostVector::empty_leaves};
+
+// ---- Cauchy-Crofton geometry (crofton.cpp)
+Box3 intersect(const Box3& a, const Box3& b);
+/// Area of a box that may be flat (one or two zero extents) or empty.
+double surface(const Box3& b);
+/// The surface a line must cross to meet the primitive: flat primitives count both sides; an
+/// open cone or cylinder counts its convex hull (side and both rims' discs).
+double crofton_area(const Scene& s, std::uint32_t id, const PrimSummary& p);
+/// Share of a primitive's bounding box that lies in `region`, measured in the dimensions where
+/// the box has extent (a flat box by area, a line by length).
+double share_inside(const Box3& pb, const Box3& region);
+
+// ---- The recursion over a materialised tree (recursion.cpp)
+/// Per-node probabilities that drive the sampled estimator's recursion, counted by its probe.
+struct NodeProbabilities {
+    // Floats: one per node of trees with millions of nodes, and probabilities need no more.
+    float handed = 0;  ///< segments handed to the node
+    float alpha = 0, beta = 0, gamma = 0.5;  ///< left only, right only, left first when both
+    /// Both children met: 1 - alpha - beta for a plane split; less for bounding volumes, whose
+    /// children need not cover their parent.
+    float both = 0;
+    float p_hit = 0;   ///< P: the segment handed to the node hits inside its region
+    /// P where the recursion uses it: among segments that meet both children of the parent
+    /// with this node first (negative: use p_hit).
+    float p_first = -1;
+    float p_bv = 1;    ///< the segment meets the node's bounding volume (when it has one)
+    /// A child of a node without a plane split: the share of the parent's visits that entered
+    /// it.
+    float entered = -1;
+    /// With `ordered`: expected primitive tests per visit of a leaf, by kind, when the search
+    /// may stop inside it (5D candidates searched in order; an any-hit query's leaves).
+    std::array<float, kPrimKinds> tests{};
+    bool ordered = false;
+    bool split = false;  ///< alpha, beta, gamma hold for this two-child node
+};
+static_assert(sizeof(NodeProbabilities) == 56);
+
+/// Each node's parent and traversal depth (the number of its ancestors that are steps), for the
+/// sampled estimator's recursion over a materialised tree.
+struct Walk {
+    std::vector<int> parent;
+    std::vector<int> tdepth;
+
+    explicit Walk(const ModelTree& t) : parent(t.nodes.size(), -1), tdepth(t.nodes.size(), 0) {
+        for (std::size_t i = 0; i < t.nodes.size(); ++i) {
+            const ModelNode& m = t.nodes[i];
+            if (m.leaf) continue;
+            for (std::uint32_t k = 0; k < m.count; ++k) {
+                parent[m.first + k] = static_cast<int>(i);
+                tdepth[m.first + k] = tdepth[i] + (m.step ? 1 : 0);
+            }
+        }
+    }
+};
+
+/// Whether a hit found ends (part of) the search: an any-hit query stops at its first hit; a
+/// closest-hit one skips what lies beyond, unless the traversal visits everything (ModelFlags::cull).
+inline bool terminates(const ModelFlags& f, Query q) { return q == Query::Any || (q == Query::Closest && f.cull); }
+
+/// The families whose `paper` node costs differ.
+enum class Family { Bvh, Grid, Rc5d, Kd, Subdivision };
+Family family_of(const std::string& f);
+
+/// Adds the operations of one visit of `m` to `c`, scaled by `p` (visits) and `pg` (visits that
+/// pass the node's bounding volume). `gamma` and `pb` (P of the first child, 0 without
+/// termination) enter the paper's Kaplan/Glassner term only.
+void charge_visit(CostVector& c, const ModelNode& m, Family f, bool paper, double p, double pg, double gamma,
+                  double pb);
+
+/// The recursion: q(child | parent visited) for every node from per-node probabilities (the
+/// recursion's coefficients), then pi and the cost vector.
+Prediction recurse(const ModelTree& t, const Walk& w, const std::vector<NodeProbabilities>& prob, const Scene& scene,
+                   const ModelOptions& opt, const UnitCosts& costs);
+
+/// The share of rays that meet the root: the recursion predicts per ray that does; every ray
+/// still pays the root test.
+void scale_to_share(Prediction& p, const ModelTree& t, double share, const UnitCosts& costs);
+
+// ---- 5D ray classification (beams.cpp)
+/// Line-measure weight of a beam whose origins lie in `m.region` (inside root box `b`).
+double beam_weight(const ModelNode& m, const Box3& b);
+/// Forward start of a primitive along a beam's dominant axis (its bounding box's near face).
+inline double forward_start(const Box3& pb, int k, bool negative) {
+    return negative ? -double(pb.hi[k]) : double(pb.lo[k]);
+}
+
+}  // namespace rtcost::model

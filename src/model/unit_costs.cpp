@@ -1,0 +1,65 @@
+// Unit costs (operation counts, or calibrated ns) and the measured cost vector.
+#include <cmath>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+#include "model_internal.hpp"
+#include "rtcost/error.hpp"
+
+namespace rtcost {
+
+double UnitCosts::scalar(const CostVector& c) const {
+    double s = per_ray + box * c.box + plane * c.plane + hop * c.hop + classify * c.classify;
+    for (int k = 0; k < kPrimKinds; ++k) s += prim[k] * c.prim[k];
+    return s;
+}
+
+UnitCosts UnitCosts::read(const std::string& path) {
+    std::ifstream in(path);
+    if (!in) throw InputError(path, 0, "no such file");
+    nlohmann::json j;
+    try {
+        j = nlohmann::json::parse(in);
+    } catch (const nlohmann::json::parse_error& e) {
+        throw InputError(path, 0, std::string("not a costs file: ") + e.what());
+    }
+    UnitCosts u;
+    auto get = [&](const nlohmann::json& obj, const char* key, double& out) {
+        if (!obj.contains(key)) return;
+        if (!obj[key].is_number() || !std::isfinite(obj[key].get<double>()) || obj[key].get<double>() < 0)
+            throw InputError(path, 0, std::string("'") + key + "' must be a non-negative number");
+        out = obj[key].get<double>();
+    };
+    get(j, "box", u.box);
+    get(j, "plane", u.plane);
+    get(j, "hop", u.hop);
+    get(j, "classify", u.classify);
+    get(j, "per_ray", u.per_ray);
+    if (j.contains("prim")) {
+        for (int k = 0; k < kPrimKinds; ++k)
+            get(j["prim"], std::string(prim_kind_name(static_cast<PrimKind>(k))).c_str(), u.prim[k]);
+    }
+    u.calibrated = j.value("unit", "") == "ns";
+    return u;
+}
+
+CostVector measured_cost(const RayCounters& c) {
+    CostVector v;
+    double n = c.rays ? static_cast<double>(c.rays) : 1.0;
+    v.box = c.box / n;
+    v.plane = c.plane / n;
+    v.hop = c.hop / n;
+    v.classify = c.classify / n;
+    for (int k = 0; k < kPrimKinds; ++k) v.prim[k] = c.prim[k] / n;
+    v.steps = c.steps / n;
+    v.leaves = c.leaves / n;
+    v.empty_leaves = c.empty_leaves / n;
+    return v;
+}
+
+void add_scaled(CostVector& y, const CostVector& x, double w) {
+    for (auto f : model::kCostFields) y.*f += w * x.*f;
+    for (int k = 0; k < kPrimKinds; ++k) y.prim[k] += w * x.prim[k];
+}
+
+}  // namespace rtcost

@@ -1,0 +1,218 @@
+// The ray sample and the segments estimator: a sample belongs to the scene and the distribution
+// (its file round-trips, its ends are brute force's), and replaying it through any hierarchy's
+// model tree with no primitive tests gives back exactly what the sampled probe counts with real
+// ones, so the estimator's only error is the sample's.
+#include <filesystem>
+#include <fstream>
+#include <unistd.h>
+
+#include "rtcost/evaluate.hpp"
+#include "rtcost/sample.hpp"
+#include "test_support.hpp"
+
+namespace rtcost::test {
+namespace {
+
+RaySet mixed_rays(const Scene& s) {
+    RaySet set;
+    set.rays = camera_rays(s.camera, 40, 40);
+    std::vector<Ray> more = random_rays(s.bounds(), 2500, 31);
+    set.rays.insert(set.rays.end(), more.begin(), more.end());
+    set.kinds.assign(set.rays.size(), RayKind::Test);
+    set.described = "camera 40x40 and random 2500";
+    return set;
+}
+
+std::string temp_path(const std::string& name) {
+    return (std::filesystem::temp_directory_path() / ("rtcost-test-" + std::to_string(::getpid()) + "-" + name)).string();
+}
+
+TEST(RaySample, EndsAreTheClosestHitsAndCrossingsAreOrderedAndUnique) {
+    Scene s = builtin_scene("balls", 2);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    auto brute = build_hierarchy(s, "brute");
+    const RaySet all = mixed_rays(s);
+    const RaySample smp = draw_sample_from(s, all, 500, 7, *ref);
+    ASSERT_EQ(smp.size(), 500u);
+    EXPECT_EQ(smp.population, all.rays.size());
+    std::size_t hits = 0;
+    for (std::size_t i = 0; i < smp.size(); ++i) {
+        Hit h;
+        brute->closest(smp.rays.rays[i], h);
+        const auto c = smp.crossings_of(i);
+        if (h.hit()) {
+            ++hits;
+            ASSERT_FALSE(c.empty());
+            EXPECT_EQ(smp.t_end[i], h.t);
+            EXPECT_EQ(static_cast<std::int32_t>(c[0].prim), h.prim);
+        } else {
+            EXPECT_TRUE(c.empty());
+            EXPECT_EQ(smp.t_end[i], smp.rays.rays[i].tmax);
+        }
+        for (std::size_t k = 1; k < c.size(); ++k) {
+            EXPECT_LT(c[k - 1].t, c[k].t);
+            for (std::size_t j = 0; j < k; ++j) EXPECT_NE(c[j].prim, c[k].prim);
+        }
+    }
+    EXPECT_GT(hits, 100u);
+}
+
+TEST(RaySample, SameSeedSameSampleAndTheTestRaysAreTheRest) {
+    Scene s = builtin_scene("tetra", 3);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    const RaySet all = mixed_rays(s);
+    const RaySample a = draw_sample_from(s, all, 300, 5, *ref), b = draw_sample_from(s, all, 300, 5, *ref);
+    const RaySample c = draw_sample_from(s, all, 300, 6, *ref);
+    ASSERT_EQ(a.size(), b.size());
+    bool differs = false;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a.rays.rays[i].o, b.rays.rays[i].o);
+        EXPECT_EQ(a.t_end[i], b.t_end[i]);
+        differs |= !(a.rays.rays[i].o == c.rays.rays[i].o);
+    }
+    EXPECT_TRUE(differs) << "another seed draws other rays";
+    // Sample and test rays partition the distribution.
+    const RaySet rest = rays_outside_sample(all, 300, 5);
+    ASSERT_EQ(rest.rays.size() + a.size(), all.rays.size());
+    std::size_t in = 0, out = 0;
+    for (const Ray& r : all.rays) {
+        auto same = [&](const Ray& x) { return x.o == r.o && x.d == r.d; };
+        in += std::any_of(a.rays.rays.begin(), a.rays.rays.end(), same);
+        out += std::any_of(rest.rays.begin(), rest.rays.end(), same);
+    }
+    EXPECT_EQ(in, a.size());
+    EXPECT_EQ(out, rest.rays.size());
+}
+
+TEST(RaySample, FileRoundTripsAndBadFilesAreRefused) {
+    Scene s = builtin_scene("balls", 2);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    const RaySample a = draw_sample_from(s, mixed_rays(s), 400, 3, *ref, Query::Closest, Query::Any);
+    const std::string path = temp_path("sample.bin");
+    write_sample(path, a);
+    const RaySample b = read_sample(path);
+    ASSERT_EQ(b.size(), a.size());
+    EXPECT_EQ(b.distribution, a.distribution);
+    EXPECT_EQ(b.population, a.population);
+    EXPECT_EQ(b.seed, a.seed);
+    ASSERT_EQ(b.crossings.size(), a.crossings.size());
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(b.rays.rays[i].d, a.rays.rays[i].d);
+        EXPECT_EQ(b.t_end[i], a.t_end[i]);
+        EXPECT_EQ(b.queries[i], a.queries[i]);
+        EXPECT_EQ(b.first[i], a.first[i]);
+    }
+    for (std::size_t i = 0; i < a.crossings.size(); ++i) {
+        EXPECT_EQ(b.crossings[i].prim, a.crossings[i].prim);
+        EXPECT_EQ(b.crossings[i].t, a.crossings[i].t);
+    }
+    // Truncated, and not a sample at all.
+    std::string bytes;
+    {
+        std::ifstream in(path, std::ios::binary);
+        bytes.assign(std::istreambuf_iterator<char>(in), {});
+    }
+    for (std::size_t cut : {std::size_t(4), std::size_t(40), bytes.size() - 3}) {
+        std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(cut));
+        EXPECT_THROW(read_sample(path), InputError) << "cut at " << cut;
+    }
+    std::ofstream(path, std::ios::binary) << "not a sample file at all, just text";
+    EXPECT_THROW(read_sample(path), InputError);
+    std::filesystem::remove(path);
+}
+
+// Every registered hierarchy the model sees into (a new one is covered without touching this
+// file), with parameters that make the lazily built ones whole.
+std::vector<Variant> modelled_variants(const Scene& s) {
+    std::vector<Variant> out;
+    for (const HierarchyInfo* info : hierarchies()) {
+        std::vector<std::string> set;
+        if (info->name == "rc5d") set = {"build=eager", "max_depth=10"};
+        if (!build_hierarchy(s, info->name, set)->modelled()) continue;
+        out.push_back({info->name, set});
+    }
+    out.push_back({"bvh-sah", {"order=none"}});
+    out.push_back({"bsp", {"traversal=recursive"}});
+    out.push_back({"octree", {"traversal=recursive", "max_prims=2"}});
+    return out;
+}
+
+TEST(ModelSegments, ReplayEqualsTheSampledProbeAndTheTraversalForEveryHierarchyAndQuery) {
+    Scene s = builtin_scene("balls", 2);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    const RaySet all = mixed_rays(s);
+    const std::size_t n = all.rays.size();
+    const RaySample smp = draw_sample_from(s, all, n, 1, *ref);
+    // Exactness needs every crossing a traversal may reach: no ray may be cut at the limit.
+    for (std::size_t i = 0; i < smp.size(); ++i) ASSERT_LT(smp.crossings_of(i).size(), kMaxCrossings);
+    std::vector<std::uint32_t> idx(n);
+    for (std::uint32_t i = 0; i < n; ++i) idx[i] = i;
+    const auto variants = modelled_variants(s);
+    EXPECT_GE(variants.size(), 12u);
+    for (const auto& [name, set] : variants) {
+        auto h = build_hierarchy(s, name, set);
+        const ModelTree t = h->model_tree();
+        for (Query q : {Query::Closest, Query::Any, Query::All}) {
+            RayCounters total;
+            for (const Ray& r : smp.rays.rays) {
+                Hit hit;
+                if (q == Query::Closest) h->closest(r, hit, total);
+                else if (q == Query::Any) h->any(r, hit, total);
+                else h->all(r, hit, total);
+            }
+            const CostVector m = measured_cost(total);
+            ModelOptions o;
+            o.query = q;
+            const Prediction seg = predict_segments(t, s, smp, idx, o);
+            const Prediction probe = predict_sampled(t, s, smp.rays.rays, o);
+            const std::string what = name + " " + ::testing::PrintToString(set) + " query " +
+                                     std::to_string(static_cast<int>(q));
+            EXPECT_EQ(seg.estimator, "segments");
+            EXPECT_NEAR(seg.scalar, probe.scalar, 1e-9 * probe.scalar) << what;
+            auto near = [&](double pred, double meas, const char* kind) {
+                EXPECT_NEAR(pred, meas, 1e-3 * meas + 1e-9) << what << " " << kind;
+            };
+            near(seg.cost.box, m.box, "box");
+            near(seg.cost.plane, m.plane, "plane");
+            near(seg.cost.hop, m.hop, "hop");
+            near(seg.cost.classify, m.classify, "classify");
+            near(seg.cost.prim_tests(), m.prim_tests(), "prim");
+            near(seg.cost.steps, m.steps, "steps");
+        }
+    }
+}
+
+TEST(ModelSegments, ASampleOfAnotherSceneIsRefused) {
+    Scene a = builtin_scene("balls", 3), b = builtin_scene("tetra", 2);
+    auto ref = build_hierarchy(a, "bvh-sah");
+    const RaySample smp = draw_sample_from(a, mixed_rays(a), 300, 1, *ref);
+    std::vector<std::uint32_t> idx(smp.size());
+    for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    auto h = build_hierarchy(b, "bvh-sah");
+    EXPECT_THROW(predict_segments(h->model_tree(), b, smp, idx, ModelOptions{}), InputError);
+}
+
+// On rays the sample did not see, the prediction errs by the sample's noise only.
+TEST(ModelSegments, EvaluatePredictsHeldOutCameraRays) {
+    Scene s = builtin_scene("balls", 3);
+    EvalOptions opt;
+    opt.hierarchies = parse_hierarchy_list("bvh-sah,kd-sah,grid,octree", s.size());
+    opt.estimators = {Estimator::Segments};
+    opt.segments = 2000;
+    RaySpec spec;
+    spec.size = "160x160";
+    const EvalResult r = evaluate(s, spec, opt);
+    EXPECT_EQ(r.sample_rays, 2000u);
+    EXPECT_EQ(r.test_rays, 160u * 160u - 2000u);
+    EXPECT_EQ(r.split, "sample");
+    ASSERT_EQ(r.rows.size(), 4u);
+    for (const EvalRow& row : r.rows) {
+        ASSERT_TRUE(row.headline());
+        EXPECT_EQ(row.headline()->estimator, "segments");
+        EXPECT_LT(std::fabs(row.error), 0.05) << row.name << " predicted " << row.headline()->scalar << " measured "
+                                              << row.measured_scalar;
+    }
+}
+
+}  // namespace
+}  // namespace rtcost::test
