@@ -36,5 +36,6 @@ struct PyHierarchy {
 
 void bind_scene(pb::module_& m);
 void bind_hierarchy(pb::module_& m);
+void bind_evaluate(pb::module_& m);
 
 }  // namespace rtcost::py

@@ -9,4 +9,5 @@ PYBIND11_MODULE(_rtcost, m) {
     pb::register_exception<rtcost::InputError>(m, "InputError", PyExc_ValueError);
     rtcost::py::bind_scene(m);
     rtcost::py::bind_hierarchy(m);
+    rtcost::py::bind_evaluate(m);
 }

@@ -16,7 +16,7 @@ SPEC = {
     "distributions": [{"dist": "lines", "count": 2000, "seed": 4}, {"dist": "camera", "size": "16x16"}],
     "threads": 1,
 }
-TIMES = {"seconds", "mrays_per_s", "threads", "build_seconds", "trace_seconds", "ns_per_ray"}
+TIMES = {"seconds", "mrays_per_s", "time", "seconds_predicting", "sample_seconds"}
 
 
 def without_times(value):
@@ -62,6 +62,15 @@ def test_a_cluster_gives_the_numbers_of_the_jobs_run_one_by_one(cluster, tmp_pat
         assert alone["status"] == "ok", alone
         assert without_times(by_job[job["job"]]) == without_times(alone)
         assert alone["per_ray"]["N_IT"] > 0 and alone["rays"] in (2000, 256)
+        # The model's row is `rtcost eval --json`'s for the same job.
+        assert alone["model"]["hierarchy"] == ":".join([job["hierarchy"]] + [f"{k}={v}" for k, v in job["params"].items()])
+        assert alone["model"]["predicted"]["cost"] > 0 and alone["model"]["measured"]["cost"] > 0
+    d = SPEC["distributions"][0]
+    want = run_cli("eval", "builtin:tetra:4", "-H", "grid:res=woo", "--rays", d["dist"], "--count", d["count"],
+                   "--seed", d["seed"], "--json").stdout
+    row = next(r for r in rows if r["scene"] == "builtin:tetra:4" and r["hierarchy"] == "grid"
+               and r["dist"] == d)
+    assert without_times(row["model"]) == without_times(json.loads(want)["results"][0])
     # The table is the rows, in the spec's order.
     assert list(df["job"]) == [j["job"] for j in _sweep.expand(SPEC)]
     assert list(df["per_ray.N_TS"]) == [by_job[j]["per_ray"]["N_TS"] for j in df["job"]]
