@@ -14,6 +14,9 @@ packages=(
   libcairo2-dev fonts-dejavu-core    # heat maps: legends drawn with a real font
   chromium                           # the report's test in a headless browser
   clang libclang-rt-14-dev llvm      # sanitizer builds, libFuzzer, symbolised reports
+  pybind11-dev python3-dev           # the Python module (Debian's /usr/bin/python3)
+  python3-numpy python3-pandas python3-pytest
+  python3-dask python3-distributed   # sweeps
 )
 # npm installs the report's plotting library (Vega-Lite) and the browser test's driver; a machine
 # with Node.js from elsewhere (e.g. NodeSource) keeps it.

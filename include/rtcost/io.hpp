@@ -48,6 +48,10 @@ inline constexpr float kMinDirection = 1e-12f, kMaxDirection = 1e12f;
 /// record has a NaN, an infinite origin or direction, a zero direction, tmin > tmax, a negative
 /// tmin, an origin beyond kMaxCoordinate, or a direction outside [kMinDirection, kMaxDirection].
 std::vector<Ray> read_rays(const std::string& path);
+/// What is wrong with a ray record by the rules read_rays applies ("origin is not finite",
+/// "tmin > tmax", ...), or empty when it is a valid ray. Rays from any source (the Python
+/// module's arrays) are checked by the same rules.
+std::string ray_problem(const Ray& r);
 /// Writes rays atomically (to a temporary file renamed into place).
 void write_rays(const std::string& path, std::span<const Ray> rays);
 

@@ -63,29 +63,32 @@ std::vector<Ray> read_rays(const std::string& path) {
         r.d = {f[3], f[4], f[5]};
         r.tmin = f[6];
         r.tmax = f[7];
-        auto bad = [&](const std::string& what) {
+        if (const std::string what = ray_problem(r); !what.empty())
             throw InputError(path, 0, "ray " + std::to_string(i) + " (byte " + std::to_string(i * kRecord) + "): " + what);
-        };
-        if (!is_finite(r.o)) bad("origin is not finite");
-        if (!is_finite(r.d)) bad("direction is not finite");
-        if (r.d == Vec3{0, 0, 0}) bad("direction is zero");
-        if (std::isnan(r.tmin) || std::isnan(r.tmax)) bad("tmin or tmax is NaN");
-        if (r.tmin == kInf) bad("tmin is +inf");
-        if (r.tmin > r.tmax) bad("tmin > tmax");
-        // Traversals clip to t >= 0 (a box's widened exit shrinks a negative interval) and Embree
-        // asserts on it: segments behind the origin are not traced.
-        if (r.tmin < 0) bad("tmin " + fmt::format("{:g}", r.tmin) + " is negative (tmin must be >= 0)");
-        const float om = std::max({std::fabs(r.o.x), std::fabs(r.o.y), std::fabs(r.o.z)});
-        if (om > kMaxCoordinate)
-            bad(fmt::format("origin reaches {:g}, beyond +-{:g}, the largest coordinate rtcost traces exactly", om,
-                            kMaxCoordinate));
-        const float dm = std::max({std::fabs(r.d.x), std::fabs(r.d.y), std::fabs(r.d.z)});
-        if (dm < kMinDirection || dm > kMaxDirection)
-            bad(fmt::format("direction's largest component {:g} is outside [{:g}, {:g}] (reciprocals and t would "
-                            "leave float's range; scale the direction)",
-                            dm, kMinDirection, kMaxDirection));
     }
     return rays;
+}
+
+std::string ray_problem(const Ray& r) {
+    if (!is_finite(r.o)) return "origin is not finite";
+    if (!is_finite(r.d)) return "direction is not finite";
+    if (r.d == Vec3{0, 0, 0}) return "direction is zero";
+    if (std::isnan(r.tmin) || std::isnan(r.tmax)) return "tmin or tmax is NaN";
+    if (r.tmin == kInf) return "tmin is +inf";
+    if (r.tmin > r.tmax) return "tmin > tmax";
+    // Traversals clip to t >= 0 (a box's widened exit shrinks a negative interval) and Embree
+    // asserts on it: segments behind the origin are not traced.
+    if (r.tmin < 0) return "tmin " + fmt::format("{:g}", r.tmin) + " is negative (tmin must be >= 0)";
+    const float om = std::max({std::fabs(r.o.x), std::fabs(r.o.y), std::fabs(r.o.z)});
+    if (om > kMaxCoordinate)
+        return fmt::format("origin reaches {:g}, beyond +-{:g}, the largest coordinate rtcost traces exactly", om,
+                           kMaxCoordinate);
+    const float dm = std::max({std::fabs(r.d.x), std::fabs(r.d.y), std::fabs(r.d.z)});
+    if (dm < kMinDirection || dm > kMaxDirection)
+        return fmt::format("direction's largest component {:g} is outside [{:g}, {:g}] (reciprocals and t would leave "
+                           "float's range; scale the direction)",
+                           dm, kMinDirection, kMaxDirection);
+    return {};
 }
 
 void write_file_atomic(const std::string& path, std::string_view bytes) {
