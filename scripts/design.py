@@ -35,6 +35,37 @@ def run(binary, scene, dist, families, size, sample):
     return json.loads(out), time.time() - start
 
 
+def sweep(binary, scene, dist, size, sample, designed, variants):
+    """One `rtcost eval` run (one core, segments estimator: the same test rays as `rtcost design`)
+    of the designed hierarchy and every variant of its yardstick; ns per ray by label."""
+    hs = ",".join([designed] + variants)
+    cmd = ["taskset", "-c", "0", binary, "eval", scene, "-H", hs, "--rays", dist, "--size", size,
+           "--estimator", "segments", "--sample", str(sample), "-j", "1", "--json", "--quiet"]
+    doc = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
+    return [(r["hierarchy"], r["time"]["measured_ns_per_ray"], r["measured"]["cost"]) for r in doc["results"]]
+
+
+def sweep_tables(a, scenes):
+    grid = [f"grid:res=hetero:density={2 ** (k / 3):.4g}" for k in range(-9, 13)]  # 22 resolutions
+    kd = [f"kd-sah:c_trav={t}:empty_bonus={b}" for t in (5, 10, 15, 20, 30) for b in (0, 0.2, 0.5)]
+    out = []
+    for fam, variants in (("grid", grid), ("kd", kd)):
+        out += ["", f"## {fam}-design against a sweep of its yardstick's parameters (`{a.sweep_dist}` rays)", "",
+                f"Every variant in one `rtcost eval -j 1` run with the designed one, pinned to one core: "
+                f"{len(variants)} variants ({'hetero grids at densities 2^(k/3), k = -9..12' if fam == 'grid' else 'kd-sah c_trav 5..30 x empty_bonus 0, 0.2, 0.5'}).", "",
+                "| scene | designed ns | best of sweep | best ns | designed / best | designed ops | best's ops |",
+                "|---|---|---|---|---|---|---|"]
+        for scene in scenes:
+            print(f"sweep {fam} {os.path.basename(scene)}", file=sys.stderr, flush=True)
+            designed = f"{fam}-design:rays={a.sweep_dist}:size={a.size}:sample={a.sample}"
+            rows = sweep(a.binary, scene, a.sweep_dist, a.size, a.sample, designed, variants)
+            d = rows[0]
+            best = min(rows[1:], key=lambda r: r[1])
+            out.append(f"| {os.path.basename(scene)} | {d[1]:.0f} | `{best[0]}` | {best[1]:.0f} | "
+                       f"{d[1] / best[1]:.3f} | {d[2]:.1f} | {best[2]:.1f} |")
+    return out
+
+
 def cpu_name():
     try:
         for line in open("/proc/cpuinfo"):
@@ -54,6 +85,8 @@ def main():
     ap.add_argument("--size", default="128x128")
     ap.add_argument("--sample", type=int, default=4096)
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "design.md"))
+    ap.add_argument("--sweep-scenes", default=",".join(SPD), help="scenes of the grid and kd sweeps ('' for none)")
+    ap.add_argument("--sweep-dist", default="spd")
     a = ap.parse_args()
     rows = []
     for scene in a.scenes.split(","):
@@ -95,6 +128,9 @@ def main():
         groups.setdefault((r["family"], dist), []).append(r["gain"])
     for (fam, dist), g in sorted(groups.items()):
         lines.append(f"| {fam} | {dist} | {len(g)} | {100 * sum(g) / len(g):+.1f}% | {100 * min(g):+.1f}% | {100 * max(g):+.1f}% |")
+    if a.sweep_scenes:
+        scenes = [scene_path(x) for x in a.sweep_scenes.split(",")]
+        lines += sweep_tables(a, [x for x in scenes if x.startswith("builtin:") or os.path.exists(x)])
     text = "\n".join(lines) + "\n"
     with open(a.out + ".tmp", "w") as f:
         f.write(text)

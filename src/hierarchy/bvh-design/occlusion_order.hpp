@@ -66,8 +66,12 @@ private:
                         next[nn++] = {n.index + k, e.depth + 1};
                 }
                 if (nn == 2 && right_first_[e.node]) std::swap(next[0], next[1]);
-                // Pushed last to first, so the first is entered next.
-                for (int i = nn - 1; i >= 0; --i) stack[sp++] = next[i];
+                if (nn > 0) {
+                    // The first is entered next, the others wait, last to first.
+                    for (int i = nn - 1; i > 0; --i) stack[sp++] = next[i];
+                    e = next[0];
+                    continue;
+                }
             }
             if (sp == 0) return false;
             e = stack[--sp];
