@@ -20,7 +20,7 @@
 namespace rtcost {
 
 /// The parameters of every designed hierarchy, with their defaults (rays=spd, sample=4096,
-/// seed=1, costs= unit costs, size= the scene's image size).
+/// seed=1, costs= unit costs, size=128x128: the image of camera-based rays the sample is drawn from).
 std::vector<ParamSpec> design_param_specs();
 
 /// A designed hierarchy's sample and the costs it minimises.

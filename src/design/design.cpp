@@ -21,10 +21,12 @@ constexpr Family kFamilies[] = {
     {"octree", "octree-design", "octree"},       {"bsp", "bsp-design", "bsp"},
 };
 
-std::vector<std::string> design_set(const DesignOptions& opt) {
+// The size is always passed: the sample must be drawn from the very rays the evaluation splits.
+std::vector<std::string> design_set(const DesignOptions& opt, const Scene& scene) {
     std::vector<std::string> set{"rays=" + opt.rays.name, "sample=" + std::to_string(opt.sample),
                                  "seed=" + std::to_string(opt.seed)};
-    if (!opt.rays.size.empty()) set.push_back("size=" + opt.rays.size);
+    set.push_back("size=" + (opt.rays.size.empty() ? fmt::format("{}x{}", scene.camera.width, scene.camera.height)
+                                                    : opt.rays.size));
     if (!opt.costs_file.empty()) set.push_back("costs=" + opt.costs_file);
     return set;
 }
@@ -58,7 +60,7 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
         for (const Family& k : kFamilies)
             if (fam == k.family) f = &k;
         EvalOptions eo;
-        eo.hierarchies.push_back({f->designed, design_set(opt)});
+        eo.hierarchies.push_back({f->designed, design_set(opt, scene)});
         eo.hierarchies.push_back(parse_hierarchy_list(f->yardstick, scene.size()).front());
         eo.hierarchies.push_back({"embree", {}});  // the speed peer, on the same rays in the same run
         eo.estimators = {Estimator::Segments};

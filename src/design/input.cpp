@@ -9,7 +9,7 @@ namespace rtcost {
 
 std::vector<ParamSpec> design_param_specs() {
     return {{"rays", "spd", "distribution the structure is designed for (any name rtcost rays takes)"},
-            {"size", "", "image size WxH of camera-based rays (default: the scene's)"},
+            {"size", "128x128", "image size WxH of the camera-based rays the sample is drawn from (empty: the scene's)"},
             {"sample", "4096", "rays in the design sample (at most half the distribution)"},
             {"seed", "1", "seed of the sample's draw (the distribution's own seed is 1)"},
             {"costs", "", "costs file of rtcost calibrate (ns per operation); empty: unit costs"}};
