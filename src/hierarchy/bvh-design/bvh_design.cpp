@@ -224,6 +224,10 @@ const Registration reg{
          p.push_back({"max_depth", "64", "deepest leaf"});
          p.push_back({"bins", "16", "bins per axis"});
          p.push_back({"candidates", "8", "surface-area-cheapest splits weighed again with the sample"});
+         p.push_back({"occlusion", "near",
+                      "order in which occlusion rays enter a node's children: near (front to back, as every BVH; "
+                      "the model describes it) or sample (the child likelier to end the ray per primitive first, "
+                      "an order bit per node; outside the model's exact replay)"});
          p.push_back({"trust", "32", "sample segments at a node at which sample and surface area weigh alike "
                                      "(large: the surface area heuristic)"});
          return p;
@@ -237,6 +241,8 @@ const Registration reg{
          o.trust = p.real("trust", 0, 1e30);
          const DesignInput in = draw_design_input(s, p);
          Designed d = build_design(s, in, o);
+         if (p.choice("occlusion", {"near", "sample"}) == "near")
+             return std::make_unique<Bvh>(s, "bvh-design", std::move(d.data), true);
          return std::make_unique<DesignedBvh>(s, std::move(d.data), std::move(d.right_first));
      }}};
 
