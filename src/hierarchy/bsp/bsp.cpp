@@ -53,6 +53,7 @@ void Bsp::build(std::uint32_t node, const Box3& cell, int depth, std::vector<std
     std::vector<std::uint8_t> mask;
     std::array<std::size_t, 8> counts;
     as.masks(refs, halves, 2, mask, counts);
+    if (o_.split_pays && !o_.split_pays(cell, refs.size(), halves, counts.data(), 2)) return make_leaf(node, refs);
     std::vector<std::uint32_t> lo = subdiv::Assigner::select(refs, mask, 0, counts[0]);
     std::vector<std::uint32_t> hi = subdiv::Assigner::select(refs, mask, 1, counts[1]);
     std::vector<std::uint32_t>().swap(refs);  // free the parent's list before descending

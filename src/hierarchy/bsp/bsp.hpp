@@ -55,13 +55,15 @@ struct Options {
     bool locate = true;
     bool mailbox = false;
     double growth = 6;  ///< see subdiv::kGrowthParam
+    subdiv::SplitTest split_pays;  ///< when set, a cell is split only where this says it pays
+    std::string name = "bsp";  ///< the registered name (a designed variant's)
 };
 
 class Bsp final : public HierarchyImpl<Bsp> {
 public:
     Bsp(const Scene& s, const Options& o);
 
-    std::string_view name() const override { return "bsp"; }
+    std::string_view name() const override { return o_.name; }
     bool emit_model(ModelSink& sink) const override;
 
     const Box3& root() const { return root_; }

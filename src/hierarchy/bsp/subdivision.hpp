@@ -22,6 +22,8 @@
 #include <array>
 #include <cmath>
 #include <cstdint>
+#include <functional>
+#include <string>
 #include <vector>
 
 #include "../common/spatial.hpp"
@@ -155,6 +157,11 @@ inline const ParamSpec kGrowthParam{
     "growth", "6",
     "a node stays a leaf when its eight octants would hold at least growth x its references together "
     "(1..9; 8: only when no octant loses one; 9: never)"};
+
+/// An optional termination test both builders call with a cell about to be split: its box, its
+/// reference count, and the `k` children it would get with their reference counts; false keeps
+/// the cell a leaf (the designed hierarchies' cost model decides there).
+using SplitTest = std::function<bool(const Box3& cell, std::size_t n, const Box3* children, const std::size_t* counts, int k)>;
 
 /// The parameters `bsp` and `octree` share, with each one's defaults for depth and leaf size.
 std::vector<ParamSpec> param_specs(int default_depth, int max_depth, int default_prims);

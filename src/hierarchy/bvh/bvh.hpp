@@ -63,6 +63,8 @@ public:
 
     std::string_view name() const override { return name_; }
     bool emit_model(ModelSink& sink) const override;
+    /// The built nodes and references (a traversal of another order reads them: bvh-design).
+    const BvhData& data() const { return d_; }
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {

@@ -102,6 +102,10 @@ struct SahOptions {
     float empty_bonus = 0.2f;  ///< cost x (1 - empty_bonus) when one side is empty
 };
 KdData build_sah(const Scene& s, const SahOptions& o);
+/// kd-sah's plane for a node: the cheapest by the SAH, or axis -1 when none beats the leaf
+/// (unless `must_split`: then the cheapest plane whatever the leaf costs; -1 only when the
+/// cell is flat or no candidate lies inside it). kd-design terminates by the model instead.
+Split sah_plane(const std::vector<BuildRef>& refs, const Box3& cell, const SahOptions& o, bool must_split);
 
 /// Clips the segment [t0, t1] to box `b`; false when they do not meet. Both ends are widened by
 /// a relative 4e-7 (about 7 ulp: the slab values' own rounding error is at most 3 ulp), so a

@@ -28,12 +28,14 @@ double area(const Box3& b) {
     return 2.0 * (x * y + y * z + z * x);
 }
 
-Split choose_sah(const std::vector<BuildRef>& refs, const Box3& cell, const SahOptions& o) {
+}  // namespace
+
+Split sah_plane(const std::vector<BuildRef>& refs, const Box3& cell, const SahOptions& o, bool must_split) {
     const std::size_t n = refs.size();
     const double sv = area(cell);
     if (!(sv > 0)) return {};
     const double leaf_cost = double(o.c_isect) * double(n);
-    double best_cost = leaf_cost;
+    double best_cost = must_split ? kInf : leaf_cost;
     Split best;
     std::vector<float> lo(n), hi(n);
     for (int a = 0; a < 3; ++a) {
@@ -83,11 +85,9 @@ Split choose_sah(const std::vector<BuildRef>& refs, const Box3& cell, const SahO
     return best;
 }
 
-}  // namespace
-
 KdData build_sah(const Scene& s, const SahOptions& o) {
     return build_tree(s, o.build, [&o](const std::vector<BuildRef>& refs, const Box3& cell, int) {
-        return choose_sah(refs, cell, o);
+        return sah_plane(refs, cell, o, false);
     });
 }
 

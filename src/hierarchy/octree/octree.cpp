@@ -42,6 +42,7 @@ void Octree::build(std::uint32_t node, const Box3& cell, int depth, std::vector<
     std::array<std::size_t, 8> counts;
     as.masks(refs, oct, 8, mask, counts);
     if (subdiv::hardly_separates(counts, refs.size(), o_.growth)) return make_leaf(node, refs);
+    if (o_.split_pays && !o_.split_pays(cell, refs.size(), oct, counts.data(), 8)) return make_leaf(node, refs);
     std::vector<std::uint32_t> child[8];
     for (int k = 0; k < 8; ++k) child[k] = subdiv::Assigner::select(refs, mask, k, counts[k]);
     std::vector<std::uint32_t>().swap(refs);  // free the parent's list before descending

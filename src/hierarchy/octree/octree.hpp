@@ -55,13 +55,15 @@ struct Options {
     bool locate = true;
     bool mailbox = false;
     double growth = 6;  ///< see subdiv::kGrowthParam
+    subdiv::SplitTest split_pays;  ///< when set, a cell is split only where this says it pays
+    std::string name = "octree";  ///< the registered name (a designed variant's)
 };
 
 class Octree final : public HierarchyImpl<Octree> {
 public:
     Octree(const Scene& s, const Options& o);
 
-    std::string_view name() const override { return "octree"; }
+    std::string_view name() const override { return o_.name; }
     bool emit_model(ModelSink& sink) const override;
 
     const Box3& root() const { return root_; }

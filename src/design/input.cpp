@@ -1,0 +1,48 @@
+// The designed hierarchies' shared parameters, their sample, and the sample's predicted cost.
+#include <algorithm>
+#include <array>
+
+#include "rtcost/design.hpp"
+#include "rtcost/error.hpp"
+
+namespace rtcost {
+
+std::vector<ParamSpec> design_param_specs() {
+    return {{"rays", "spd", "distribution the structure is designed for (any name rtcost rays takes)"},
+            {"size", "128x128", "image size WxH of the camera-based rays the sample is drawn from (empty: the scene's)"},
+            {"sample", "4096", "rays in the design sample (at most half the distribution)"},
+            {"seed", "1", "seed of the sample's draw (the distribution's own seed is 1)"},
+            {"costs", "", "costs file of rtcost calibrate (ns per operation); empty: unit costs"}};
+}
+
+DesignInput draw_design_input(const Scene& scene, const Params& p) {
+    DesignInput in;
+    in.spec.name = p.str("rays");
+    in.spec.size = p.str("size");
+    in.spec.seed = 1;
+    in.count = static_cast<std::size_t>(p.integer("sample", 1, 1 << 20));
+    in.seed = static_cast<std::uint64_t>(p.integer("seed", 0, (1LL << 62)));
+    if (!p.str("costs").empty()) in.costs = UnitCosts::read(p.str("costs"));
+    const RaySet all = make_rays(scene, in.spec);
+    const std::size_t n = std::min(in.count, all.rays.size() / 2);
+    if (n == 0) throw InputError("--set", 0, "rays=" + in.spec.name + ": too few rays to draw a design sample from");
+    auto reference = build_hierarchy(scene, "bvh-sah");
+    in.sample = draw_sample_from(scene, all, n, in.seed, *reference);
+    return in;
+}
+
+double sample_cost(const ModelTree& tree, const Scene& scene, const RaySample& sample, const UnitCosts& costs) {
+    std::array<std::vector<std::uint32_t>, 3> by_query;
+    for (std::uint32_t i = 0; i < sample.size(); ++i) by_query[static_cast<int>(sample.queries[i])].push_back(i);
+    double sum = 0;
+    for (int q = 0; q < 3; ++q) {
+        if (by_query[q].empty()) continue;
+        ModelOptions o;
+        o.query = static_cast<Query>(q);
+        const Prediction pr = predict_segments(tree, scene, sample, by_query[q], o, costs);
+        sum += pr.scalar * static_cast<double>(by_query[q].size());
+    }
+    return sample.size() ? sum / static_cast<double>(sample.size()) : 0;
+}
+
+}  // namespace rtcost

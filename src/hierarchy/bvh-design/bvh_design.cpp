@@ -1,0 +1,250 @@
+// `bvh-design`: a binned BVH builder whose split cost takes each child's visit probability from
+// the design sample (the share of the node's sample segments, clipped where each ray's search
+// ends, that meet the child's box), blended with the surface-area ratio where few segments reach
+// the node; a node stays a leaf where no split pays; and per node the order in which occlusion
+// rays enter its children (occlusion_order.hpp). Otherwise traversed as every BVH (../bvh/bvh.hpp).
+#include <algorithm>
+#include <unordered_map>
+
+#include <map>
+
+#include "../bvh/topdown.hpp"
+#include "occlusion_order.hpp"
+#include "rtcost/design.hpp"
+
+namespace rtcost::bvh {
+namespace {
+
+/// A trust at or above this: no sample weight at all.
+constexpr double kNoTrust = 1e30;
+
+struct DesignOptions {
+    int max_prims = 32;   ///< a larger node is always split
+    int max_depth = 64;
+    int bins = 16;
+    int candidates = 8;   ///< SAH-cheapest splits re-weighed with the sample
+    double trust = 32;    ///< sample segments at which the sample and the surface area weigh alike
+};
+
+struct Cut {
+    int axis = -1;
+    int at = 0;           // first bin on the right
+    float sah = kInf;     // A_L N_L + A_R N_R
+    Box3 left, right;
+    std::uint32_t n_left = 0, n_right = 0;
+};
+
+// Every bin boundary on every axis with its surface-area cost, cheapest first.
+std::vector<Cut> binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
+                             const PrimInfo& info, const Box3& cb, int nbins) {
+    std::vector<Cut> cuts;
+    struct Bin {
+        Box3 box;
+        std::uint32_t n = 0;
+    };
+    std::vector<Bin> bins(nbins);
+    std::vector<Box3> suffix(nbins + 1);
+    std::vector<std::uint32_t> suffix_n(nbins + 1);
+    for (int axis = 0; axis < 3; ++axis) {
+        const float lo = cb.lo[axis], ext = cb.hi[axis] - lo;
+        if (!(ext > 0)) continue;
+        const float scale = nbins / ext;
+        std::fill(bins.begin(), bins.end(), Bin{});
+        for (std::uint32_t i = begin; i < end; ++i) {
+            const int b = std::min(nbins - 1, static_cast<int>((info.centroids[ids[i]][axis] - lo) * scale));
+            bins[b].box.extend(info.bounds[ids[i]]);
+            ++bins[b].n;
+        }
+        suffix[nbins] = Box3{};
+        suffix_n[nbins] = 0;
+        for (int b = nbins - 1; b >= 0; --b) {
+            suffix[b] = suffix[b + 1];
+            suffix[b].extend(bins[b].box);
+            suffix_n[b] = suffix_n[b + 1] + bins[b].n;
+        }
+        Box3 prefix;
+        std::uint32_t n = 0;
+        for (int b = 0; b + 1 < nbins; ++b) {
+            prefix.extend(bins[b].box);
+            n += bins[b].n;
+            if (n == 0 || suffix_n[b + 1] == 0) continue;
+            cuts.push_back({axis, b + 1, prefix.area() * n + suffix[b + 1].area() * suffix_n[b + 1], prefix,
+                            suffix[b + 1], n, suffix_n[b + 1]});
+        }
+    }
+    // Ties keep the order of generation (axis, then bin), as a strict "<" over them would.
+    std::stable_sort(cuts.begin(), cuts.end(), [](const Cut& a, const Cut& b) { return a.sah < b.sah; });
+    return cuts;
+}
+
+struct Designed {
+    BvhData data;
+    std::vector<std::uint8_t> right_first;
+};
+
+// Each interior node's order bit from the (begin, end) primitive ranges the builder decided it on.
+std::vector<std::uint8_t> order_bits(const BvhData& d, const std::map<std::pair<std::uint32_t, std::uint32_t>, bool>& by_range) {
+    std::vector<std::uint8_t> bits(d.nodes.size(), 0);
+    auto range = [&](auto&& self, std::uint32_t i) -> std::pair<std::uint32_t, std::uint32_t> {
+        const Node& n = d.nodes[i];
+        if (n.leaf) return {n.index, n.index + n.count};
+        const auto l = self(self, n.index);
+        const auto r = self(self, n.index + n.count - 1);
+        for (std::uint32_t k = 1; k + 1 < n.count; ++k) self(self, n.index + k);
+        if (auto it = by_range.find({l.first, r.second}); it != by_range.end()) bits[i] = it->second;
+        return {l.first, r.second};
+    };
+    if (!d.nodes.empty()) range(range, 0);
+    return bits;
+}
+
+Designed build_design(const Scene& s, const DesignInput& in, const DesignOptions& o) {
+    PrimInfo info(s);
+    const RaySample& smp = in.sample;
+    std::vector<RayInv> inv;
+    inv.reserve(smp.size());
+    for (std::size_t i = 0; i < smp.size(); ++i) inv.emplace_back(smp.rays.rays[i]);
+    auto meets = [&](std::uint32_t r, const Box3& b) {
+        const Ray& ray = smp.rays.rays[r];
+        return box_entry(b, inv[r], ray.tmin, std::min(ray.tmax, smp.t_end[r])) != kInf;
+    };
+    // Mean cost of a primitive test and of a binary node's visit (two box tests), in the costs' units.
+    double prim_cost = 0;
+    for (std::uint32_t i = 0; i < s.size(); ++i) prim_cost += in.costs.prim[static_cast<int>(s.kind(i))];
+    prim_cost = s.size() ? prim_cost / s.size() : 1;
+    const double trav_cost = 2 * in.costs.box;
+
+    // The sample segments reaching each node, keyed by the node's first primitive: a node is split
+    // before its subtrees are built, and the left child's subtree is done before the right one's.
+    std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> reaching;
+    // Occlusion order: the child an any-hit ray reaching the node is likelier to end in (one of
+    // its known crossings lies among the child's primitives and its segment meets the child's
+    // box), per primitive to test there, is entered first.
+    std::map<std::pair<std::uint32_t, std::uint32_t>, bool> right_first;
+    std::vector<std::uint8_t> side(s.size(), 0);
+    {
+        std::vector<std::uint32_t> all;
+        for (std::uint32_t r = 0; r < smp.size(); ++r)
+            if (meets(r, s.bounds())) all.push_back(r);
+        reaching[0] = std::move(all);
+    }
+    BvhData data = build_topdown(s, info, [&](std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
+                                      const Box3& box, int depth) -> std::uint32_t {
+        std::vector<std::uint32_t> rays = std::move(reaching[begin]);
+        reaching.erase(begin);
+        const std::uint32_t n = end - begin;
+        if (depth >= o.max_depth) return begin;
+        Box3 cb;
+        for (std::uint32_t i = begin; i < end; ++i) cb.extend(info.centroids[ids[i]]);
+        std::vector<Cut> cuts = binned_cuts(ids, begin, end, info, cb, o.bins);
+        const double area = box.area();
+        const double m = static_cast<double>(rays.size());
+        // trust >= kNoTrust: the surface area alone, computed as bvh-sah computes it (in float, the
+        // first cheapest cut), so that the design falls back to the SAH's tree exactly.
+        const double w = o.trust >= kNoTrust ? 0 : m / (m + o.trust);
+        // Expected cost below this node, per ray reaching it: a leaf tests every primitive; a split
+        // tests both child boxes and each child's primitives as often as the child is entered.
+        double best = kInf;
+        int chosen = -1;
+        std::vector<std::uint32_t> best_left, best_right;
+        const int k = std::min<int>(w == 0 ? 1 : o.candidates, static_cast<int>(cuts.size()));
+        for (int c = 0; c < k; ++c) {
+            const Cut& cut = cuts[c];
+            double pl = area > 0 ? cut.left.area() / area : 1, pr = area > 0 ? cut.right.area() / area : 1;
+            std::vector<std::uint32_t> lr, rr;
+            if (w > 0) {
+                for (std::uint32_t r : rays) {
+                    if (meets(r, cut.left)) lr.push_back(r);
+                    if (meets(r, cut.right)) rr.push_back(r);
+                }
+                pl = w * (lr.size() / m) + (1 - w) * pl;
+                pr = w * (rr.size() / m) + (1 - w) * pr;
+            }
+            const double cost =
+                w == 0 ? static_cast<double>(static_cast<float>(trav_cost) +
+                                             static_cast<float>(prim_cost) * (area > 0 ? cut.sah / static_cast<float>(area) : n))
+                       : trav_cost + prim_cost * (pl * cut.n_left + pr * cut.n_right);
+            if (cost < best) {
+                best = cost, chosen = c;
+                best_left = std::move(lr), best_right = std::move(rr);
+            }
+        }
+        const double leaf = w == 0 ? static_cast<double>(static_cast<float>(prim_cost) * n) : prim_cost * n;
+        if (static_cast<int>(n) <= o.max_prims && leaf <= best) return begin;
+        auto by_axis0 = [&](std::uint32_t a, std::uint32_t b) {
+            const float ca = info.centroids[a][0], cb0 = info.centroids[b][0];
+            return ca < cb0 || (ca == cb0 && a < b);
+        };
+        std::uint32_t mid;
+        if (chosen < 0) {
+            // All centroids coincide: halve the list.
+            mid = begin + n / 2;
+            std::nth_element(ids.begin() + begin, ids.begin() + mid, ids.begin() + end, by_axis0);
+            best_left = best_right = rays;
+        } else {
+            const Cut& cut = cuts[chosen];
+            const float lo = cb.lo[cut.axis], scale = o.bins / (cb.hi[cut.axis] - lo);
+            auto it = std::partition(ids.begin() + begin, ids.begin() + end, [&](std::uint32_t id) {
+                const int b = std::min(o.bins - 1, static_cast<int>((info.centroids[id][cut.axis] - lo) * scale));
+                return b < cut.at;
+            });
+            mid = static_cast<std::uint32_t>(it - ids.begin());
+            if (w == 0) best_left = best_right = {};
+        }
+        if (!rays.empty() && mid > begin && mid < end) {
+            for (std::uint32_t i = begin; i < end; ++i) side[ids[i]] = i < mid ? 1 : 2;
+            Box3 lb, rb;
+            for (std::uint32_t i = begin; i < mid; ++i) lb.extend(info.bounds[ids[i]]);
+            for (std::uint32_t i = mid; i < end; ++i) rb.extend(info.bounds[ids[i]]);
+            double ends[3] = {0, 0, 0};
+            for (std::uint32_t r : rays) {
+                if (smp.queries[r] != Query::Any) continue;
+                bool in_side[3] = {false, false, false};
+                for (const Crossing& c : smp.crossings_of(r)) in_side[side[c.prim]] = true;
+                if (in_side[1] && meets(r, lb)) ++ends[1];
+                if (in_side[2] && meets(r, rb)) ++ends[2];
+            }
+            for (std::uint32_t i = begin; i < end; ++i) side[ids[i]] = 0;
+            if (ends[1] * (end - mid) < ends[2] * (mid - begin)) right_first[{begin, end}] = true;
+        }
+        reaching[begin] = std::move(best_left);
+        reaching[mid] = std::move(best_right);
+        return mid;
+    });
+    std::vector<std::uint8_t> bits = order_bits(data, right_first);
+    return {std::move(data), std::move(bits)};
+}
+
+const Registration reg{
+    {"bvh-design",
+     "binned BVH whose splits minimise the cost model with visit probabilities from a sample of the given rays",
+     [] {
+         std::vector<ParamSpec> p = design_param_specs();
+         p.push_back({"max_prims", "32", "largest leaf (bigger nodes are always split)"});
+         p.push_back({"max_depth", "64", "deepest leaf"});
+         p.push_back({"bins", "16", "bins per axis"});
+         p.push_back({"candidates", "8", "surface-area-cheapest splits weighed again with the sample"});
+         p.push_back({"occlusion", "near",
+                      "order in which occlusion rays enter a node's children: near (front to back, as every BVH; "
+                      "the model describes it) or sample (the child likelier to end the ray per primitive first, "
+                      "an order bit per node; outside the model's exact replay)"});
+         p.push_back({"trust", "32", "sample segments at a node at which sample and surface area weigh alike "
+                                     "(large: the surface area heuristic)"});
+         return p;
+     }(),
+     [](const Scene& s, const Params& p) -> std::unique_ptr<Hierarchy> {
+         DesignOptions o;
+         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
+         o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
+         o.bins = static_cast<int>(p.integer("bins", 2, 256));
+         o.candidates = static_cast<int>(p.integer("candidates", 1, 3 * 256));
+         o.trust = p.real("trust", 0, 1e30);
+         const DesignInput in = draw_design_input(s, p);
+         Designed d = build_design(s, in, o);
+         if (p.choice("occlusion", {"near", "sample"}) == "near")
+             return std::make_unique<Bvh>(s, "bvh-design", std::move(d.data), true);
+         return std::make_unique<DesignedBvh>(s, std::move(d.data), std::move(d.right_first));
+     }}};
+
+}  // namespace
+}  // namespace rtcost::bvh

@@ -1,0 +1,85 @@
+#pragma once
+// bvh-design's hierarchy: the BVH's nodes and traversal for closest-hit and all-hits queries,
+// and for occlusion (any-hit) queries a walk that enters first, at each node, the child the
+// design sample says is likelier to end the ray per unit of its cost (one order bit per node):
+// an any-hit query needs no hit nearer than another, only one soon.
+
+#include <vector>
+
+#include "../bvh/bvh.hpp"
+
+namespace rtcost::bvh {
+
+class DesignedBvh final : public HierarchyImpl<DesignedBvh> {
+public:
+    /// `right_first[i]`: interior node i's second child is entered first by occlusion rays.
+    DesignedBvh(const Scene& s, BvhData data, std::vector<std::uint8_t> right_first)
+        : HierarchyImpl(s), bvh_(s, "bvh-design", std::move(data), true), right_first_(std::move(right_first)) {}
+
+    std::string_view name() const override { return "bvh-design"; }
+    bool emit_model(ModelSink& sink) const override { return bvh_.emit_model(sink); }
+    const std::vector<std::uint8_t>& right_first() const { return right_first_; }
+
+    template <class C, Query Q>
+    bool trace(const Ray& ray, Hit& hit, C& counting) const {
+        if constexpr (Q == Query::Any) return occlusion(ray, hit, counting);
+        else return bvh_.template trace<C, Q>(ray, hit, counting);
+    }
+
+protected:
+    StructureStats compute_structure() const override {
+        StructureStats st = bvh_.structure();
+        st.bytes += right_first_.size();
+        return st;
+    }
+
+private:
+    // Counted as the BVH's walk counts: one box for the root, per interior visit interior(depth)
+    // and one box per child, per leaf visit leaf(depth, n) and its primitive tests.
+    template <class C>
+    bool occlusion(const Ray& ray, Hit& hit, C& counting) const {
+        const BvhData& d = bvh_.data();
+        const Node* nodes = d.nodes.data();
+        const RayInv ri(ray);
+        counting.box();
+        if (box_entry(nodes[0].box, ri, ray.tmin, ray.tmax) == kInf) return false;
+        struct Entry {
+            std::uint32_t node;
+            int depth;
+        };
+        Entry stack[kMaxDepth * (kMaxFanout - 1) + 2];
+        int sp = 0;
+        Entry e{0, 0};
+        for (;;) {
+            const Node& n = nodes[e.node];
+            if (n.leaf) {
+                counting.leaf(e.depth, n.count);
+                for (std::uint32_t k = 0; k < n.count; ++k)
+                    if (test_prim(*scene_, d.refs[n.index + k], ray, hit, counting)) return true;
+            } else {
+                counting.interior(e.depth);
+                Entry next[kMaxFanout];
+                int nn = 0;
+                for (std::uint32_t k = 0; k < n.count; ++k) {
+                    counting.box();
+                    if (box_entry(nodes[n.index + k].box, ri, ray.tmin, ray.tmax) != kInf)
+                        next[nn++] = {n.index + k, e.depth + 1};
+                }
+                if (nn == 2 && right_first_[e.node]) std::swap(next[0], next[1]);
+                if (nn > 0) {
+                    // The first is entered next, the others wait, last to first.
+                    for (int i = nn - 1; i > 0; --i) stack[sp++] = next[i];
+                    e = next[0];
+                    continue;
+                }
+            }
+            if (sp == 0) return false;
+            e = stack[--sp];
+        }
+    }
+
+    Bvh bvh_;
+    std::vector<std::uint8_t> right_first_;
+};
+
+}  // namespace rtcost::bvh

@@ -1,0 +1,94 @@
+// `grid-design`: the resolution search over candidate grids, each predicted on the design
+// sample through its model tree (no primitive tests), and the registration.
+#include "grid_design.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <map>
+
+namespace rtcost::grid {
+
+std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, spatial::Assign assign, bool mailbox,
+                                         std::uint64_t max_cells) {
+    std::map<std::array<int, 3>, double> seen;
+    const Box3 box = s.bounds();
+    auto cost = [&](std::array<int, 3> r) -> double {
+        for (int a = 0; a < 3; ++a) r[a] = std::clamp(r[a], 1, kMaxRes);
+        if (auto it = seen.find(r); it != seen.end()) return it->second;
+        const std::uint64_t cells = std::uint64_t(r[0]) * r[1] * r[2];
+        double c = kInf;
+        if (cells <= max_cells) {
+            const Grid g(s, r, assign, mailbox);
+            c = sample_cost(g.model_tree(), s, in.sample, in.costs);
+        }
+        seen[r] = c;
+        return c;
+    };
+    std::array<int, 3> best{1, 1, 1};
+    double best_cost = kInf;
+    for (double density : {0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0}) {
+        const std::array<int, 3> r = resolution("hetero", density, s.size(), box);
+        const double c = cost(r);
+        if (c < best_cost) best_cost = c, best = r;
+    }
+    // Coordinate descent: each axis up or down by a third until no step lowers the cost.
+    for (int round = 0; round < 6; ++round) {
+        bool improved = false;
+        for (int a = 0; a < 3; ++a) {
+            const float ext = std::max({box.hi[0] - box.lo[0], box.hi[1] - box.lo[1], box.hi[2] - box.lo[2]});
+            if (!(box.hi[a] - box.lo[a] > kFlat * ext)) continue;
+            for (double f : {4.0 / 3.0, 3.0 / 4.0}) {
+                std::array<int, 3> r = best;
+                r[a] = std::max(1, static_cast<int>(std::lround(best[a] * f)));
+                if (r[a] == best[a]) r[a] = f > 1 ? best[a] + 1 : std::max(1, best[a] - 1);
+                if (r == best) continue;
+                const double c = cost(r);
+                if (c < best_cost) {
+                    best_cost = c, best = r, improved = true;
+                    break;
+                }
+            }
+        }
+        if (!improved) break;
+    }
+    std::vector<Candidate> out;
+    for (const auto& [r, c] : seen) out.push_back({r, c});
+    // Cheapest first; ties to the fewest cells, then the resolution, so the order is the same
+    // on every machine.
+    std::sort(out.begin(), out.end(), [](const Candidate& x, const Candidate& y) {
+        if (x.cost != y.cost) return x.cost < y.cost;
+        const auto cx = std::uint64_t(x.res[0]) * x.res[1] * x.res[2], cy = std::uint64_t(y.res[0]) * y.res[1] * y.res[2];
+        if (cx != cy) return cx < cy;
+        return x.res < y.res;
+    });
+    return out;
+}
+
+namespace {
+
+std::vector<ParamSpec> params() {
+    std::vector<ParamSpec> p = design_param_specs();
+    p.push_back({"max_density", "8", "largest candidate grid, in cells per primitive"});
+    p.push_back(spatial::kAssignParam);
+    p.push_back(spatial::kMailboxParam);
+    return p;
+}
+
+const Registration reg{
+    {"grid-design",
+     "uniform grid whose per-axis resolution minimises the cost model's prediction for a sample of the given rays",
+     params(),
+     [](const Scene& s, const Params& p) -> std::unique_ptr<Hierarchy> {
+         const DesignInput in = draw_design_input(s, p);
+         const spatial::Assign assign = spatial::parse_assign(p);
+         const bool mailbox = p.flag("mailbox");
+         const double md = p.real("max_density", 0.01, 64);
+         const auto max_cells =
+             std::min<std::uint64_t>(kMaxCells, static_cast<std::uint64_t>(std::max(1.0, md * static_cast<double>(s.size()))) + 64);
+         std::vector<Candidate> tried = search_resolution(s, in, assign, mailbox, max_cells);
+         auto g = std::make_unique<Grid>(s, tried.front().res, assign, mailbox);
+         return std::make_unique<GridDesign>(s, std::move(g), std::move(tried));
+     }}};
+
+}  // namespace
+}  // namespace rtcost::grid

@@ -1,0 +1,57 @@
+// `kd-design`: kd-sah's planes with the model's termination. A node stays a leaf when the cost
+// model, with visit probabilities from the design sample (the share of the node's sample
+// segments, clipped where each ray's search ends, that meet each child cell, blended with the
+// surface-area ratio where few reach the node), says splitting it does not pay: Subramanian and
+// Fussell's automatic termination with the user's rays instead of isotropic lines.
+#include "../kd/kdtree.hpp"
+#include "design/cell_rays.hpp"
+
+namespace rtcost::kd {
+namespace {
+
+// kd-sah's cheapest plane for the node, kept when the model says the split pays.
+struct Designer {
+    SahOptions sah;
+    designing::CellRays cells;
+
+    Split choose(const std::vector<BuildRef>& refs, const Box3& cell) {
+        const Split sp = sah_plane(refs, cell, sah, true);
+        if (sp.axis < 0) return sp;
+        const int a = sp.axis;
+        std::size_t counts[2] = {0, 0};
+        for (const BuildRef& r : refs) {
+            counts[0] += r.box.lo[a] <= sp.pos;
+            counts[1] += r.box.hi[a] >= sp.pos;
+        }
+        const Box3 halves[2] = {spatial::half(cell, a, sp.pos, 0), spatial::half(cell, a, sp.pos, 1)};
+        return cells.split_pays(cell, refs.size(), halves, counts, 2) ? sp : Split{};
+    }
+};
+
+const Registration reg{
+    {"kd-design",
+     "kd-sah's planes, terminated where the cost model with a sample of the given rays says a split does not pay",
+     [] {
+         std::vector<ParamSpec> p = design_param_specs();
+         p.push_back({"max_depth", "auto", "deepest leaf: auto (8 + 1.3 log2 N) or 0..64"});
+         p.push_back({"trust", "32", "sample segments at a node at which sample and surface area weigh alike"});
+         p.push_back(spatial::kAssignParam);
+         p.push_back(spatial::kMailboxParam);
+         return p;
+     }(),
+     [](const Scene& s, const Params& p) -> std::unique_ptr<Hierarchy> {
+         const DesignInput in = draw_design_input(s, p);
+         // An interior visit of kd-sah's traversal: one plane.
+         Designer d{{}, designing::CellRays(s, in, p.real("trust", 0, 1e30), in.costs.plane)};
+         d.sah.build.max_prims = 0;
+         d.sah.build.max_depth = p.str("max_depth") == "auto" ? default_max_depth(s.size())
+                                                              : static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
+         d.sah.build.assign = spatial::parse_assign(p);
+         const Chooser choose = [&d](const std::vector<BuildRef>& refs, const Box3& cell, int) {
+             return d.choose(refs, cell);
+         };
+         return std::make_unique<KdTree>(s, "kd-design", build_tree(s, d.sah.build, choose), p.flag("mailbox"));
+     }}};
+
+}  // namespace
+}  // namespace rtcost::kd

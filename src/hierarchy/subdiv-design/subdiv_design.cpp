@@ -1,0 +1,46 @@
+// `octree-design`, `bsp-design`: Glassner's octree and Kaplan's BSP tree built by their own
+// builders, a cell split only where the cost model, with visit probabilities from a sample of
+// the given rays, says the split pays (design/cell_rays.hpp) -- instead of splitting down to
+// max_prims or max_depth.
+#include "../bsp/bsp.hpp"
+#include "../octree/octree.hpp"
+#include "design/cell_rays.hpp"
+
+namespace rtcost {
+namespace {
+
+std::vector<ParamSpec> specs(int default_depth, int max_depth, int default_prims) {
+    std::vector<ParamSpec> p = design_param_specs();
+    for (const ParamSpec& q : subdiv::param_specs(default_depth, max_depth, default_prims)) p.push_back(q);
+    p.push_back({"trust", "32", "sample segments at a cell at which sample and surface area weigh alike"});
+    return p;
+}
+
+// Builds with the model's split test; the test (and the sample it reads) lives only during the build.
+template <class H, class O>
+std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, int max_depth, double planes, const char* name) {
+    const DesignInput in = draw_design_input(s, p);
+    designing::CellRays cells(s, in, p.real("trust", 0, 1e30), planes * in.costs.plane);
+    O o = subdiv::read_options<O>(p, max_depth);
+    o.name = name;
+    o.split_pays = [&cells](const Box3& cell, std::size_t n, const Box3* children, const std::size_t* counts, int k) {
+        return cells.split_pays(cell, n, children, counts, k);
+    };
+    return std::make_unique<H>(s, o);
+}
+
+// The operations of one interior visit: an octree node's three planes, a BSP node's one.
+const Registration octree_reg{
+    {"octree-design", "Glassner's octree, a cell split only where the cost model with a sample of the given rays says it pays",
+     specs(12, octree::kMaxDepth, 1),
+     [](const Scene& s, const Params& p) {
+         return build<octree::Octree, octree::Options>(s, p, octree::kMaxDepth, 3, "octree-design");
+     }}};
+
+const Registration bsp_reg{
+    {"bsp-design", "Kaplan's BSP tree, a cell split only where the cost model with a sample of the given rays says it pays",
+     specs(30, bsp::kMaxDepth, 1),
+     [](const Scene& s, const Params& p) { return build<bsp::Bsp, bsp::Options>(s, p, bsp::kMaxDepth, 1, "bsp-design"); }}};
+
+}  // namespace
+}  // namespace rtcost

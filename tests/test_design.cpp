@@ -1,0 +1,153 @@
+// The designed hierarchies: exact hits like every hierarchy (closest and any-hit), the same
+// structure for the same seed, the SAH's tree where the sample is given no weight, a grid
+// resolution no worse on the sample than the formula's, and `rtcost design`'s rows.
+#include "rtcost/design.hpp"
+#include "rtcost/evaluate.hpp"
+#include "rtcost/sample.hpp"
+#include "test_support.hpp"
+
+namespace rtcost::test {
+namespace {
+
+// Small samples of small images keep the designs quick; the structure still follows the rays.
+const std::vector<Variant> kDesigned = {
+    {"grid-design", {"rays=spd", "size=48x48", "sample=512"}},
+    {"grid-design", {"rays=shadow", "size=48x48", "sample=256", "seed=3", "mailbox=1"}},
+    {"bvh-design", {"rays=spd", "size=48x48", "sample=512"}},
+    {"bvh-design", {"rays=ao", "size=48x48", "sample=512", "max_prims=4", "occlusion=sample"}},
+    {"bvh-design", {"rays=shadow", "size=48x48", "sample=512", "occlusion=sample"}},
+    {"bvh-design", {"rays=camera", "size=48x48", "sample=256", "trust=0"}},
+    {"kd-design", {"rays=spd", "size=48x48", "sample=512"}},
+    {"kd-design", {"rays=shadow", "size=48x48", "sample=256", "mailbox=1", "assign=exact"}},
+    {"octree-design", {"rays=spd", "size=48x48", "sample=512"}},
+    {"octree-design", {"rays=diffuse", "size=48x48", "sample=256", "traversal=recursive"}},
+    {"bsp-design", {"rays=spd", "size=48x48", "sample=512"}},
+    {"bsp-design", {"rays=ao", "size=48x48", "sample=256", "traversal=recursive", "mailbox=1"}},
+};
+
+std::string spec_of(const std::string& name) { return name.rfind("builtin:", 0) == 0 ? name : spd_path(name); }
+
+class DesignScene : public ::testing::TestWithParam<std::string> {};
+
+TEST_P(DesignScene, DesignedHierarchiesMatchBruteForceExactly) {
+    const std::string spec = spec_of(GetParam());
+    if (spec.rfind("builtin:", 0) != 0 && !std::filesystem::exists(spec)) GTEST_SKIP() << spec << " not present";
+    const Scene s = load_scene(spec);
+    const std::vector<Ray> rays = hard_rays(s, 3000, 17);
+    expect_variants_match_brute(s, rays, GetParam(), kDesigned);
+    // Occlusion: an any-hit query hits exactly where brute force's closest query does.
+    auto brute = build_hierarchy(s, "brute");
+    const std::vector<Hit> want = closest_hits(*brute, rays);
+    for (const auto& [name, set] : kDesigned) {
+        auto h = build_hierarchy(s, name, set);
+        TraceOptions o;
+        o.query = Query::Any;
+        const TraceResult any = trace_rays(*h, rays, o);
+        std::size_t bad = 0;
+        for (std::size_t i = 0; i < rays.size(); ++i) bad += any.hits[i].hit() != want[i].hit();
+        EXPECT_EQ(bad, 0u) << GetParam() << " " << name << " any-hit";
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, DesignScene,
+                         ::testing::Values("builtin:balls:2", "builtin:tetra:3", "balls", "gears", "lattice", "mount",
+                                           "rings", "shells", "sombrero", "teapot", "tetra", "tree"),
+                         [](const auto& info) {
+                             std::string n = info.param;
+                             for (char& c : n)
+                                 if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                             return n;
+                         });
+
+void expect_same_tree(const ModelTree& a, const ModelTree& b, const std::string& what) {
+    ASSERT_EQ(a.nodes.size(), b.nodes.size()) << what;
+    ASSERT_EQ(a.prims, b.prims) << what;
+    std::size_t bad = 0;
+    for (std::size_t i = 0; i < a.nodes.size(); ++i) {
+        const ModelNode &x = a.nodes[i], &y = b.nodes[i];
+        bad += !(x.region.lo == y.region.lo && x.region.hi == y.region.hi && x.leaf == y.leaf && x.count == y.count &&
+                 x.first == y.first && x.axis == y.axis && x.split == y.split);
+    }
+    EXPECT_EQ(bad, 0u) << what;
+}
+
+TEST(Design, SameSeedSameStructure) {
+    const Scene s = builtin_scene("balls", 2);
+    for (const auto& [name, set] : kDesigned) {
+        auto a = build_hierarchy(s, name, set);
+        auto b = build_hierarchy(s, name, set);
+        expect_same_tree(a->model_tree(), b->model_tree(), name);
+    }
+}
+
+TEST(Design, DesignSampleIsEvalsOwnDraw) {
+    // The hierarchy's sample is the draw `eval --estimator segments` leaves out of its test rays.
+    const Scene s = builtin_scene("balls", 2);
+    Params p(design_param_specs(), {"rays=spd", "size=32x32", "sample=300", "seed=5"});
+    const DesignInput in = draw_design_input(s, p);
+    RaySpec spec;
+    spec.name = "spd";
+    spec.size = "32x32";
+    const RaySet all = make_rays(s, spec);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    const RaySample want = draw_sample_from(s, all, 300, 5, *ref);
+    ASSERT_EQ(in.sample.size(), 300u);
+    EXPECT_EQ(in.sample.t_end, want.t_end);
+    for (std::size_t i = 0; i < want.size(); ++i) ASSERT_EQ(in.sample.rays.rays[i].o, want.rays.rays[i].o) << i;
+}
+
+TEST(Design, BvhDesignWithNoSampleWeightIsTheSahTree) {
+    // trust=1e30: the sample weighs nothing, and the split cost is the SAH's with a traversal
+    // step of two box tests and a primitive test of one: bvh-sah's tree, node for node.
+    for (const char* scene : {"builtin:balls:2", "builtin:tetra:3", "gears", "tree"}) {
+        const std::string spec = spec_of(scene);
+        if (spec.rfind("builtin:", 0) != 0 && !std::filesystem::exists(spec)) continue;
+        const Scene s = load_scene(spec);
+        auto d = build_hierarchy(s, "bvh-design", {"rays=camera", "size=16x16", "sample=64", "trust=1e30", "max_prims=8"});
+        auto sah = build_hierarchy(s, "bvh-sah", {"c_trav=2"});
+        expect_same_tree(d->model_tree(), sah->model_tree(), scene);
+    }
+}
+
+TEST(Design, GridDesignIsNoWorseOnItsSampleThanTheFormula) {
+    for (const char* scene : {"builtin:balls:2", "builtin:tetra:3", "gears", "rings"}) {
+        const std::string spec = spec_of(scene);
+        if (spec.rfind("builtin:", 0) != 0 && !std::filesystem::exists(spec)) continue;
+        const Scene s = load_scene(spec);
+        const std::vector<std::string> set{"rays=spd", "size=48x48", "sample=1024"};
+        auto d = build_hierarchy(s, "grid-design", set);
+        auto hetero = build_hierarchy(s, "grid", {"res=hetero"});
+        Params p(design_param_specs(), set);
+        const DesignInput in = draw_design_input(s, p);
+        const double cd = sample_cost(d->model_tree(), s, in.sample, in.costs);
+        const double ch = sample_cost(hetero->model_tree(), s, in.sample, in.costs);
+        // hetero at density 1 is the search's first candidate: the choice can only be cheaper.
+        EXPECT_LE(cd, ch) << scene;
+    }
+}
+
+TEST(Design, DesignReportsEachFamilyOnDisjointRays) {
+    const Scene s = builtin_scene("balls", 2);
+    DesignOptions o;
+    o.rays.name = "spd";
+    o.rays.size = "32x32";
+    o.sample = 256;
+    const DesignResult r = design(s, o);
+    ASSERT_EQ(r.rows.size(), design_families().size());
+    EXPECT_EQ(r.sample, 256u);
+    const std::size_t pop = make_rays(s, o.rays).rays.size();
+    EXPECT_EQ(r.test_rays, pop - 256);
+    for (const DesignRow& row : r.rows) {
+        EXPECT_GT(row.designed_ns, 0) << row.family;
+        EXPECT_GT(row.designed_measured, 0) << row.family;
+        EXPECT_GT(row.yardstick_predicted, 0) << row.family;
+    }
+    const nlohmann::json j = to_json(r);
+    ASSERT_EQ(j["results"].size(), r.rows.size());
+    EXPECT_EQ(j["results"][0]["family"], "grid");
+    EXPECT_EQ(j["results"][0]["designed"], "grid-design");
+    EXPECT_EQ(j["results"][0]["set"][0], "rays=spd");
+}
+
+}  // namespace
+}  // namespace rtcost::test
