@@ -213,6 +213,7 @@ TEST(AdversarialBounds, CoincidentCopiesKeepTheGridsReferencesAndTestsBoundedAnd
 
 TEST(AdversarialBounds, SpdScenesAreNotLimited) {
     // The bounds stop only adversarial builds: the SPD scenes build as before.
+    for (const char* name : {"balls", "tetra", "rings", "teapot"}) RTCOST_REQUIRE_SPD(name);
     for (const char* name : {"balls", "tetra", "rings", "teapot"}) {
         Scene s = load_scene(spd_path(name));
         for (const char* hname : {"grid", "bsp", "octree", "rc5d"}) {

@@ -24,7 +24,7 @@ def _list(v):
 
 
 def evaluate(scene, hierarchies="all", rays="camera", *, size=None, count=100000, seed=1, kinds=None,
-             estimator="geometric", preset="exact", query="closest", shadow="any", sample=0, sample_file=None,
+             estimator="segments", preset="exact", query="closest", shadow="any", sample=0, sample_file=None,
              costs=None, threads=0, by_depth=False, table=True):
     """Builds each hierarchy over `scene`, predicts its cost per ray with the model, measures it on
     the same rays, and ranks them: what `rtcost eval --json` prints.

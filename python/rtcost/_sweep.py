@@ -5,7 +5,7 @@ A spec (a dict, or the path of a JSON file holding one):
     {"scenes": ["builtin:balls:2", "builtin:tetra:4"],
      "hierarchies": ["bvh-sah", {"name": "grid", "params": {"res": ["woo", "hetero"]}}],
      "distributions": [{"dist": "lines", "count": 5000, "seed": 1}, {"dist": "camera", "size": "32x32"}],
-     "query": "closest", "estimator": "geometric", "preset": "exact",
+     "query": "closest", "estimator": "segments", "preset": "exact",
      "out": "sweep.jsonl", "scheduler": null, "workers": 2, "threads": 1}
 
 Every hierarchy entry is a name or {"name", "params"}; a parameter given a list is swept over
@@ -90,7 +90,7 @@ def expand(spec, where="spec"):
         if not isinstance(d, dict) or "dist" not in d or set(d) - _DIST_KEYS:
             raise _error(where, f"distributions[{i}]: a name or {{\"dist\", \"size\", \"count\", \"seed\"}}")
         dists.append(d)
-    common = {"query": spec.get("query", "closest"), "estimator": spec.get("estimator", "geometric"),
+    common = {"query": spec.get("query", "closest"), "estimator": spec.get("estimator", "segments"),
               "preset": spec.get("preset", "exact"), "threads": int(spec.get("threads", 1))}
     jobs = []
     for scene, (name, params), dist in itertools.product(scenes, variants, dists):

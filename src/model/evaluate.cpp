@@ -145,7 +145,8 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                std::string split) {
     if (opt.hierarchies.empty()) throw InputError("--hierarchy", 0, "no hierarchy named");
     if (opt.estimators.empty() || opt.presets.empty()) throw InputError("--estimator", 0, "no estimator or preset");
-    if (test.rays.empty()) throw InputError("--rays", 0, "no test rays");
+    if (test.rays.empty())
+        throw InputError("--rays", 0, "no test rays are left: the estimators need training and test rays (use more rays)");
     const bool sampled = wants(opt, Estimator::Sampled);
     const UnitCosts& costs = opt.costs;
     auto query_of = [&](int k) { return is_occlusion(static_cast<RayKind>(k)) ? opt.occlusion : opt.query; };
@@ -309,12 +310,12 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
 
 }  // namespace
 
-EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& opt) {
-    RaySet test = make_rays(scene, spec);
-    RaySet train;
+namespace {
+/// The segments estimator's sample (drawn from `test`, or read from opt.sample_file), left out of
+/// `test`.
+std::optional<RaySample> take_sample(const Scene& scene, RaySet& test, const EvalOptions& opt, double& seconds,
+                                     std::string& split) {
     std::optional<RaySample> sample;
-    double sample_seconds = 0;
-    std::string split = "none";
     if (wants(opt, Estimator::Segments)) {
         // The sample is left out of the test rays, which are every other ray of the distribution.
         const auto start = std::chrono::steady_clock::now();
@@ -331,15 +332,25 @@ EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& 
             const std::size_t n = opt.segments > 0 ? opt.segments
                                                    : std::min<std::size_t>(4096, std::max(pop / 50, std::min<std::size_t>(256, pop / 4)));
             if (n == 0 || n >= test.rays.size())
-                throw InputError("--segments", 0, "a sample of " + std::to_string(n) + " out of " +
+                throw InputError("--sample", 0, "a sample of " + std::to_string(n) + " out of " +
                                                       std::to_string(test.rays.size()) + " rays leaves no test rays");
             auto reference = build_hierarchy(scene, "bvh-sah");
             sample = draw_sample_from(scene, test, n, opt.sample_seed, *reference, opt.query, opt.occlusion);
         }
         test = rays_outside_sample(test, sample->size(), sample->seed);
-        sample_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         split = "sample";
     }
+    return sample;
+}
+}  // namespace
+
+EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& opt) {
+    RaySet test = make_rays(scene, spec);
+    RaySet train;
+    double sample_seconds = 0;
+    std::string split = "none";
+    std::optional<RaySample> sample = take_sample(scene, test, opt, sample_seconds, split);
     if (wants(opt, Estimator::Sampled)) {
         if (spec.name == "lines" || spec.name == "random" || spec.name == "aimed") {
             // A fresh draw of the same distribution with another seed.
@@ -359,12 +370,17 @@ EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& 
 }
 
 EvalResult evaluate(const Scene& scene, RaySet rays, const EvalOptions& opt) {
-    if (wants(opt, Estimator::Segments))
-        throw InputError("--estimator", 0, "the segments estimator needs a distribution to sample (not a ray set)");
     RaySet train;
-    if (!wants(opt, Estimator::Sampled)) return run(scene, std::move(rays), train, nullptr, opt, "none");
-    split_half(rays, train, opt.sample);
-    return run(scene, std::move(rays), train, nullptr, opt, "pseudo-random half");
+    double sample_seconds = 0;
+    std::string split = "none";
+    std::optional<RaySample> sample = take_sample(scene, rays, opt, sample_seconds, split);
+    if (wants(opt, Estimator::Sampled)) {
+        split_half(rays, train, opt.sample);
+        split = split == "none" ? "pseudo-random half" : split + " and pseudo-random half";
+    }
+    EvalResult r = run(scene, std::move(rays), train, sample ? &*sample : nullptr, opt, split);
+    r.sample_seconds = sample_seconds;
+    return r;
 }
 
 }  // namespace rtcost

@@ -58,7 +58,8 @@ def test_the_table(scene):
     df = rtcost.evaluate(scene, ["bvh-sah", scene.build("grid", res="woo")], rtcost.rays(scene, "lines", count=2000))
     assert list(df["hierarchy"]) == ["bvh-sah", "grid:res=woo"]
     assert {"predicted.cost", "measured.cost", "error", "rank_predicted", "build.N_IN"} <= set(df.columns)
-    assert df.attrs["scene"] == SCENE and df.attrs["rays"] == 2000
+    # The segments estimator (the default) leaves its sample out of the test rays.
+    assert df.attrs["scene"] == SCENE and df.attrs["rays"] + df.attrs["sample_rays"] == 2000 and df.attrs["sample_rays"] > 0
     assert sorted(df["rank_measured"]) == [1, 2]
 
 
