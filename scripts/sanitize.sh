@@ -28,6 +28,7 @@ cmake --build build-asan -j "$jobs" --target rtcost_tests rtcost_cli
 echo "sanitize: asan build $(t "$start") s"
 export ASAN_OPTIONS="detect_leaks=1:abort_on_error=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
+export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp"
 # Left out: the scene-wide cross-checks (every SPD scene, built-in scene and mesh through every
 # hierarchy against brute force, 100k+ rays each: "SceneCheck*" alone missed the Builtin/ and
 # Mesh/ instances, which ran for over ten minutes under ASan) and the README's commands; the
