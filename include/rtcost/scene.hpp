@@ -96,7 +96,9 @@ public:
     /// Adds a polygon over `verts`; returns false (adding nothing) when it is degenerate. A
     /// polygon of more than three vertices that is not planar (a vertex off its plane by more
     /// than 1e-6 of its size) is flattened onto the plane of its normal, keeping its outline in
-    /// the projection the intersection uses; `flattened` (if given) says so.
+    /// the projection the intersection uses; `flattened` (if given) says so when the polygon is
+    /// non-planar beyond what float rounding of planar input explains (1e-5 of its size off a
+    /// plane fitted in double), which is what a reader warns about.
     bool add_polygon(std::span<const Vec3> verts, std::uint32_t material, std::uint32_t* id = nullptr,
                      bool* flattened = nullptr);
 

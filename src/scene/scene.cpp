@@ -16,9 +16,31 @@ namespace {
 // that drops the normal's largest axis. A non-planar polygon's hits therefore lie off its
 // vertices' box, where no hierarchy looks. Moving each vertex along the dropped axis onto the
 // plane keeps the projected outline (what the inside test reads) and puts the hits inside the
-// vertices' box again. Returns false (changing nothing) when every vertex is within 1e-6 of the
-// polygon's size of its plane, which float rounding of planar input already reaches.
-bool flatten_polygon(const Polygon& p, std::vector<Vec3>& pool) {
+// vertices' box again. Nothing changes when every vertex is within 1e-6 of the polygon's size of
+// its (float) plane.
+enum class Flattening { none, rounding, nonplanar };
+
+// Whether the vertices leave a plane fitted in double (Newell's normal through their centroid) by
+// more than 1e-5 of the polygon's size: planar input written as text and read into floats stays
+// far below that, while the float normal alone can put a thin planar quad 1e-6 off its plane.
+bool visibly_nonplanar(const Vec3* v, std::uint32_t count, double size) {
+    double n[3] = {0, 0, 0}, c[3] = {0, 0, 0};
+    for (std::uint32_t i = 0; i < count; ++i) {
+        const Vec3 a = v[i], b = v[(i + 1) % count];
+        n[0] += (double(a.y) - b.y) * (double(a.z) + b.z);
+        n[1] += (double(a.z) - b.z) * (double(a.x) + b.x);
+        n[2] += (double(a.x) - b.x) * (double(a.y) + b.y);
+        for (int k = 0; k < 3; ++k) c[k] += double(a[k]) / count;
+    }
+    const double len = std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    if (!(len > 0)) return true;
+    double off = 0;
+    for (std::uint32_t i = 0; i < count; ++i)
+        off = std::max(off, std::fabs((n[0] * (v[i].x - c[0]) + n[1] * (v[i].y - c[1]) + n[2] * (v[i].z - c[2])) / len));
+    return off > 1e-5 * size;
+}
+
+Flattening flatten_polygon(const Polygon& p, std::vector<Vec3>& pool) {
     Vec3* v = pool.data() + p.first;
     Box3 box;
     for (std::uint32_t i = 0; i < p.count; ++i) box.extend(v[i]);
@@ -28,11 +50,12 @@ bool flatten_polygon(const Polygon& p, std::vector<Vec3>& pool) {
     double off = 0;
     for (std::uint32_t i = 0; i < p.count; ++i)
         off = std::max(off, std::fabs(n[0] * v[i].x + n[1] * v[i].y + n[2] * v[i].z - double(p.plane_d)));
-    if (!(off > 1e-6 * size)) return false;
+    if (!(off > 1e-6 * size)) return Flattening::none;
+    const bool nonplanar = visibly_nonplanar(v, p.count, size);
     const int k = p.drop_axis, a = (k + 1) % 3, b = (k + 2) % 3;
     for (std::uint32_t i = 0; i < p.count; ++i)
         v[i][k] = static_cast<float>((double(p.plane_d) - n[a] * v[i][a] - n[b] * v[i][b]) / n[k]);
-    return true;
+    return nonplanar ? Flattening::nonplanar : Flattening::rounding;
 }
 
 }  // namespace
@@ -103,8 +126,9 @@ bool Scene::add_polygon(std::span<const Vec3> verts, std::uint32_t material, std
         return false;
     }
     if (flattened) *flattened = false;
-    if (p.count > 3 && flatten_polygon(p, polygon_vertices)) {
-        if (flattened) *flattened = true;
+    const Flattening f = p.count > 3 ? flatten_polygon(p, polygon_vertices) : Flattening::none;
+    if (f != Flattening::none) {
+        if (flattened) *flattened = f == Flattening::nonplanar;
         if (!setup_polygon(p, polygon_vertices)) {
             polygon_vertices.resize(p.first);
             return false;
