@@ -72,8 +72,13 @@ int cmd_eval(EvalArgs& a, const Common& common) {
     // measured.
     Progress progress("eval", 0, common.quiet || common.json);
     opt.on_step = [&](const std::string& step) { progress.note(step); };
+    // A new bar whenever the step changes: the runner need not report 0 before its first rays.
+    std::string shown_step;
     opt.on_progress = [&](const std::string& step, std::size_t done, std::size_t total) {
-        if (done == 0 || done == total) progress.restart(step, total);
+        if (step != shown_step || done == 0) {
+            progress.restart(step, total);
+            shown_step = step;
+        }
         progress.update(done);
     };
     bool first = true;
@@ -81,6 +86,7 @@ int cmd_eval(EvalArgs& a, const Common& common) {
         fmt::print("scene {} ({} primitives: {})\n", scene.name, scene.size(), kind_summary(scene));
     opt.on_row = [&](const EvalRow& row) {
         progress.finish();
+        shown_step.clear();
         if (common.json) return;
         if (first) std::cout << eval_columns();
         first = false;

@@ -4,8 +4,9 @@
 #     coverage instrumentation, so that scripts/fuzz.sh reuses this build). The whole suite runs
 #     except the SPD-wide suites (every SPD scene through every hierarchy: those run in the
 #     Release suite; the built-in, adversarial and reliability scenes exercise the same code).
-#  2. build-tsan/: clang with ThreadSanitizer: multi-threaded tracing through every hierarchy,
-#     the lazily grown rc5d included, and the rc5d suites.
+#  2. build-tsan/: clang with ThreadSanitizer, the library and the threaded tests only:
+#     multi-threaded tracing through every hierarchy, the lazily grown rc5d included, and the
+#     rc5d suites.
 # Any sanitizer report fails the script. JOBS=N sets the build jobs (default 2).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -46,18 +47,19 @@ for i in 0 1; do wait "${pids[$i]}" || { status=1; cat "build-asan/shard-$i.log"
 [ $status -eq 0 ] || { echo "sanitize: asan tests failed"; exit 1; }
 echo "sanitize: asan tests $(t "$start") s"
 
-# ThreadSanitizer needs a build of its own (about six minutes on two cores): CI skips it to stay
-# within its time (RTCOST_TSAN=0 in .ci/run); run it with RTCOST_TSAN=1 (the default here).
+# ThreadSanitizer: a build of its own, of the library and the threaded tests only
+# (rtcost_thread_tests: test_threads.cpp and test_rc5d.cpp), so that CI holds it beside the
+# ASan build. RTCOST_TSAN=0 skips it.
 if [ "${RTCOST_TSAN:-1}" = 0 ]; then
   echo "sanitize: ThreadSanitizer skipped (RTCOST_TSAN=0)"
   exit 0
 fi
 tsan="-fsanitize=thread"
-configure build-tsan "$tsan"
+configure build-tsan "$tsan" -DRTCOST_BUILD_PYTHON=OFF
 start=$(date +%s)
-cmake --build build-tsan -j "$jobs" --target rtcost_tests rtcost_cli
+cmake --build build-tsan -j "$jobs" --target rtcost_thread_tests
 echo "sanitize: tsan build $(t "$start") s"
 export TSAN_OPTIONS="halt_on_error=1:suppressions=$PWD/scripts/tsan.supp"
 start=$(date +%s)
-build-tsan/tests/rtcost_tests --gtest_filter="Reliability.Threaded*:Rc5dBuild.*:Rc5dHits.*" --gtest_brief=1
+build-tsan/tests/rtcost_thread_tests --gtest_filter="Reliability.Threaded*:Rc5dBuild.*:Rc5dHits.*" --gtest_brief=1
 echo "sanitize: tsan tests $(t "$start") s"

@@ -12,6 +12,7 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kVariants = 
     {"bvh-median", {}},
     {"bvh-median", {"order=none"}},
     {"bvh-gs", {}},
+    {"bvh-gs", {"seed=0"}},
     {"bvh-gs", {"seed=7", "max_prims=3"}},
     {"bvh-sah", {}},
     {"bvh-sah", {"sweep=1", "order=none"}},

@@ -210,8 +210,9 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         }
         row.measured_rays = rays->rays.size();
         auto progress = [&](const std::string& step) {
-            if (opt.on_step) opt.on_step(step + " " + req.label());
-            if (opt.on_progress) to.progress = [&, step](std::size_t done) { opt.on_progress(step, done, rays->rays.size()); };
+            const std::string named = step + " " + req.label();
+            if (opt.on_step) opt.on_step(named);
+            if (opt.on_progress) to.progress = [&, named](std::size_t done) { opt.on_progress(named, done, rays->rays.size()); };
         };
         // Counted first, so a lazily built hierarchy (rc5d) is complete when timed.
         progress("counting");

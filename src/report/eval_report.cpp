@@ -100,6 +100,15 @@ std::string eval_columns() {
                        "nodes", "bytes", "predicted", "counted", "error", "ns/ray", "spread", "Mrays/s");
 }
 
+namespace {
+// The bounds that stopped a build, under its row: the numbers above are of a structure cut short.
+std::string limit_lines(const StructureStats& s) {
+    std::string out;
+    for (const std::string& l : s.limits) out += fmt::format("  limit: {}\n", l);
+    return out;
+}
+}  // namespace
+
 std::string eval_row(const EvalRow& row) {
     const Prediction* head = row.headline();
     return fmt::format("{:<12} {:>9.4f} {:>9} {:>10} {:>11} {:>11} {:>8} {:>10.1f} {:>7} {:>9.3f}\n", row.name,
@@ -108,7 +117,8 @@ std::string eval_row(const EvalRow& row) {
                        row.counted ? fmt::format("{:.2f}", row.measured_scalar) : "-",
                        head && row.counted ? fmt::format("{:+.1f}%", 100 * row.error) : "-", row.ns_per_ray,
                        row.repeats > 1 ? fmt::format("{:.0f}%", 100 * row.time_spread) : std::string("-"),
-                       row.mrays_per_s);
+                       row.mrays_per_s) +
+           limit_lines(row.structure);
 }
 
 std::string eval_header(const EvalResult& r) {

@@ -19,6 +19,7 @@ StructureStats Bvh::compute_structure() const {
     StructureStats s = tree_structure(
         d_.nodes, [](const Node& n) { return n.leaf != 0; }, [](const Node& n) { return std::uint32_t(n.count); });
     s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + prims_.size() * sizeof(LeafPrim);
+    s.limits = d_.limits;
     return s;
 }
 
@@ -72,7 +73,8 @@ const Registration gs_reg{
      {{"max_prims", "1", "largest leaf (1: one object per leaf, as in the original)"},
       {"max_depth", "64", "deepest node"},
       {"max_children", "8", "largest fan-out of a node (2..8)"},
-      {"seed", "0", "insertion order: 0 = file order, otherwise shuffled with this seed"},
+      {"seed", "1", "insertion order: shuffled with this seed; 0 = file order (which degenerates on "
+                   "meshes stored row by row)"},
       kOrder},
      [](const Scene& s, const Params& p) {
          GsOptions o;

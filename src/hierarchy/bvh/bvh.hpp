@@ -4,6 +4,7 @@
 // fill `BvhData`.
 
 #include <algorithm>
+#include <string>
 #include <vector>
 
 #include "rtcost/hierarchy.hpp"
@@ -28,6 +29,7 @@ inline constexpr int kMaxDepth = 100;
 struct BvhData {
     std::vector<Node> nodes;           ///< nodes[0] is the root
     std::vector<std::uint32_t> refs;   ///< primitive ids in leaf order
+    std::vector<std::string> limits;   ///< bounds that stopped the build, for StructureStats::limits
 };
 
 /// Per-primitive bounds and centroids, computed once per build.
@@ -41,7 +43,7 @@ struct PrimInfo {
 struct MedianOptions { int max_prims = 1; int max_depth = 64; };
 BvhData build_median(const Scene& s, const MedianOptions& o);
 
-struct GsOptions { int max_prims = 1; int max_depth = 64; int max_children = kMaxFanout; std::uint64_t seed = 0; };
+struct GsOptions { int max_prims = 1; int max_depth = 64; int max_children = kMaxFanout; std::uint64_t seed = 1; };
 BvhData build_gs(const Scene& s, const GsOptions& o);
 
 struct SahOptions {

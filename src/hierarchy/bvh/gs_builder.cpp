@@ -7,6 +7,7 @@
 // Cost, in units of area (probability of a ray meeting a box is proportional to its area):
 // every child box of an interior node N is tested when N is entered (area(N) each), and every
 // primitive of a leaf L when L is entered (area(L) each).
+#include <fmt/format.h>
 #include <stdexcept>
 
 #include "bvh.hpp"
@@ -81,6 +82,7 @@ public:
                     double cost = join(nodes_[c].box, b).area() - nodes_[c].box.area();
                     if (cost < best) { best = cost; what = kIntoLeaf; best_child = c; }
                 }
+                if (best < kInf) ++overfull_;
             }
             if (best == kInf) {
                 // No leaf child either: descend into the cheapest child (its subtree is within the
@@ -167,8 +169,14 @@ private:
         return static_cast<std::uint32_t>(nodes_.size() - 1);
     }
 
+public:
+    /// Insertions that the depth bound pushed into a leaf already holding max_prims.
+    std::size_t overfull() const { return overfull_; }
+
+private:
     const PrimInfo& info_;
     const GsOptions& o_;
+    std::size_t overfull_ = 0;
     std::vector<GNode> nodes_;
     std::vector<std::uint32_t> path_;
 };
@@ -186,7 +194,14 @@ BvhData build_gs(const Scene& s, const GsOptions& o) {
     }
     GsTree tree(info, o);
     for (std::uint32_t id : order) tree.insert(id);
-    return tree.flatten();
+    BvhData d = tree.flatten();
+    if (tree.overfull() > 0)
+        d.limits.push_back(fmt::format("bvh-gs: max_depth {} reached: {} of {} primitives went into leaves already "
+                                       "holding max_prims ({}); {}",
+                                       o.max_depth, tree.overfull(), s.size(), o.max_prims,
+                                       o.seed == 0 ? "the file's order degenerates here, shuffle it with --set seed=1"
+                                                   : "raise max_prims or max_depth"));
+    return d;
 }
 
 }  // namespace rtcost::bvh
