@@ -18,7 +18,7 @@ struct DesignArgs {
 };
 
 int cmd_design(DesignArgs& a, const Common& common) {
-    Scene scene = load(a.scene, common);
+    Scene scene = load(a.scene, common, a.opt.rays.view);
     if (a.families != "all") {
         std::size_t start = 0;
         while (start <= a.families.size()) {
@@ -43,6 +43,7 @@ Subcommand setup_design(CLI::App& parent, Common& common) {
     cmd->add_option("SCENE", a->scene, "scene file or builtin:NAME[:level]")->required();
     cmd->add_option("-r,--rays", a->opt.rays.name, "the distribution to design for (see rtcost rays)")->capture_default_str();
     cmd->add_option("--size", a->opt.rays.size, "image size WxH for camera-based rays (default: the scene's)");
+    add_view_args(cmd, a->opt.rays.view);
     cmd->add_option("--family", a->families, "families to design, comma-separated (grid, bvh, ...), or all")
         ->capture_default_str();
     cmd->add_option("--sample", a->opt.sample, "rays in the design sample")->capture_default_str();

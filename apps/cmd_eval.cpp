@@ -49,6 +49,7 @@ int cmd_eval(EvalArgs& a, const Common& common) {
     EvalOptions opt;
     opt.costs = a.costs.empty() ? UnitCosts{} : UnitCosts::read(a.costs);
     opt.hierarchies = parse_hierarchy_list(a.hierarchies, scene.size());
+    opt.left_out = left_out_of_all(a.hierarchies, scene.size());
     if (!a.set.empty()) {
         if (opt.hierarchies.size() > 1)
             throw InputError("--set", 0,

@@ -29,6 +29,7 @@ struct ReportArgs {
 json run_eval(const ReportArgs& a, const Scene& scene, const UnitCosts& costs, const Common& common) {
     EvalOptions opt;
     opt.hierarchies = parse_hierarchy_list(a.hierarchies, scene.size());
+    opt.left_out = left_out_of_all(a.hierarchies, scene.size());
     opt.estimators = {a.estimator == "geometric" ? Estimator::Geometric
                       : a.estimator == "segments" ? Estimator::Segments
                                                   : Estimator::Sampled};

@@ -26,6 +26,19 @@ TEST(EvalList, PerHierarchyParametersAndTheMeaningOfAll) {
     EXPECT_TRUE(has(parse_hierarchy_list("all", kBruteLimit), "brute"));
     EXPECT_FALSE(has(parse_hierarchy_list("all", kBruteLimit + 1), "brute"));
     EXPECT_FALSE(has(parse_hierarchy_list("all", 10), "embree"));
+    // Large scenes: the slow builders leave all, and left_out_of_all names exactly those.
+    const auto large = parse_hierarchy_list("all", kLargeScene + 1);
+    const auto out = left_out_of_all("all", kLargeScene + 1);
+    for (const char* slow : {"brute", "bvh-gs", "kd-median", "kd-sah", "kd-design", "grid-design", "octree-design"}) {
+        EXPECT_FALSE(has(large, slow)) << slow;
+        EXPECT_NE(std::find(out.begin(), out.end(), slow), out.end()) << slow;
+    }
+    for (const char* kept : {"bvh-sah", "bvh-wide", "grid", "octree", "bsp", "rc5d", "bvh-design"})
+        EXPECT_TRUE(has(large, kept)) << kept;
+    EXPECT_EQ(large.size() + out.size() + 1, hierarchies().size());  // embree: never in all
+    EXPECT_TRUE(has(parse_hierarchy_list("all", kLargeScene), "kd-sah"));
+    EXPECT_EQ(left_out_of_all("all", kLargeScene), std::vector<std::string>{"brute"});
+    EXPECT_TRUE(left_out_of_all("bvh-sah,kd-sah", kLargeScene + 1).empty());
 }
 
 TEST(EvalRun, EmbreeIsTimedNotCountedAndRanksOnlyByTime) {

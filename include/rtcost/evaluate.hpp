@@ -29,14 +29,17 @@ struct HierarchyRequest {
 
 /// Parses a hierarchy list: "all", or comma-separated "name[:key=value[:key=value...]]" (e.g.
 /// "bvh-gs:seed=1,octree:max_depth=6,grid"). "all" is every registered hierarchy that makes
-/// sense over `primitives` primitives (no embree; no brute above kBruteLimit primitives).
-/// Throws InputError naming `what` for an unknown name or a malformed entry.
+/// sense over `primitives` primitives (no embree; none over its HierarchyInfo::all_up_to: brute
+/// above kBruteLimit, the slow builders above kLargeScene). Throws InputError naming `what` for
+/// an unknown name or a malformed entry.
 std::vector<HierarchyRequest> parse_hierarchy_list(std::string_view list, std::size_t primitives,
                                                    const std::string& what = "--hierarchy");
+/// The hierarchies that "all" leaves out over `primitives` primitives (embree aside), by name.
+std::vector<std::string> left_out_of_all(std::string_view list, std::size_t primitives);
 
 /// Above this many primitives `all` leaves brute force out (ask for it by name), and brute force
 /// asked for is measured on a subset of the rays: about kBruteTests primitive tests in all.
-inline constexpr std::size_t kBruteLimit = 5000;
+inline constexpr std::size_t kBruteLimit = kBruteInAll;
 inline constexpr std::size_t kBruteTests = 200'000'000;
 
 struct EvalRow;
@@ -44,6 +47,8 @@ struct EvalRow;
 /// What to evaluate and how.
 struct EvalOptions {
     std::vector<HierarchyRequest> hierarchies;
+    /// Hierarchies "all" left out at this scene's size (left_out_of_all), reported with the result.
+    std::vector<std::string> left_out;
     /// Estimators and presets to evaluate; the first of each gives the headline prediction.
     std::vector<Estimator> estimators{Estimator::Sampled};
     std::vector<Preset> presets{Preset::Exact};
@@ -113,6 +118,7 @@ struct EvalResult {
     std::vector<Preset> presets;
     bool calibrated = false;
     std::vector<EvalRow> rows;
+    std::vector<std::string> left_out;  ///< EvalOptions::left_out
 };
 
 /// Evaluates `opt.hierarchies` over `scene` on the rays `spec` names. With the sampled

@@ -9,6 +9,7 @@
 
 #include <functional>
 #include <map>
+#include <limits>
 #include <memory>
 #include <span>
 #include <string>
@@ -257,7 +258,15 @@ struct HierarchyInfo {
     std::string description;
     std::vector<ParamSpec> params;
     std::function<std::unique_ptr<Hierarchy>(const Scene&, const Params&)> build;
+    /// `-H all` takes it over at most this many primitives: beyond, its build or trace is too
+    /// slow for a first look, and `eval` says it was left out (naming it still builds it).
+    std::size_t all_up_to = std::numeric_limits<std::size_t>::max();
 };
+
+/// Brute force tests every primitive for every ray: `-H all` takes it on small scenes only.
+inline constexpr std::size_t kBruteInAll = 5000;
+/// Where the builders that grow faster than N log N (or trace like brute force) leave `-H all`.
+inline constexpr std::size_t kLargeScene = 250000;
 
 /// All registered hierarchies, sorted by name.
 std::vector<const HierarchyInfo*> hierarchies();

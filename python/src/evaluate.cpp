@@ -47,6 +47,7 @@ pb::object evaluate_py(const Scene& scene, const std::string& hierarchies, const
                        const std::string& sample_file, const std::string& costs, int threads, bool by_depth) {
     EvalOptions opt;
     opt.hierarchies = parse_hierarchy_list(hierarchies, scene.size(), "hierarchies");
+    opt.left_out = left_out_of_all(hierarchies, scene.size());
     opt.estimators = estimators_from(estimators);
     opt.presets = presets_from(presets);
     opt.query = query_from_name(query);

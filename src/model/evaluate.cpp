@@ -41,13 +41,20 @@ std::string HierarchyRequest::label() const {
     return out;
 }
 
+std::vector<std::string> left_out_of_all(std::string_view list, std::size_t primitives) {
+    std::vector<std::string> out;
+    if (list != "all") return out;
+    for (const HierarchyInfo* h : hierarchies())
+        if (h->name != "embree" && primitives > h->all_up_to) out.push_back(h->name);
+    return out;
+}
+
 std::vector<HierarchyRequest> parse_hierarchy_list(std::string_view list, std::size_t primitives,
                                                    const std::string& what) {
     std::vector<HierarchyRequest> out;
     if (list == "all") {
         for (const HierarchyInfo* h : hierarchies()) {
-            if (h->name == "embree") continue;
-            if (h->name == "brute" && primitives > kBruteLimit) continue;
+            if (h->name == "embree" || primitives > h->all_up_to) continue;
             out.push_back({h->name, {}});
         }
         return out;
@@ -164,6 +171,7 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
     res.distribution = test.described;
     res.test_rays = test.rays.size();
     res.training_rays = train.rays.size();
+    res.left_out = opt.left_out;
     std::array<std::vector<std::uint32_t>, kRayKinds> sample_kinds;
     if (sample) {
         res.sample_rays = sample->size();

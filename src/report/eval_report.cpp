@@ -92,6 +92,7 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
             {"sample_seconds", r.sample_seconds},
             {"split", r.split},
             {"unit_costs", r.calibrated ? "ns" : "operations"},
+            {"left_out", r.left_out},
             {"results", results}};
 }
 
@@ -133,12 +134,21 @@ std::string eval_header(const EvalResult& r) {
                             : fmt::format("{} training rays ({}) left out of them", r.training_rays, r.split);
     if (r.split.find(" and ") != std::string::npos)
         split = fmt::format("a sample of {} rays and {} training rays left out of them", r.sample_rays, r.training_rays);
+    std::string left_out;
+    for (const std::string& name : r.left_out) left_out += (left_out.empty() ? "" : ", ") + name;
+    if (!left_out.empty())
+        left_out = fmt::format("left out of all at {} primitives (slow at this size; name them with -H to have them): {}\n",
+                               r.primitives, left_out);
     return fmt::format("scene {} ({} primitives), {} test rays ({}); {}\nqueries: {}\nmodel: {} estimator, {} preset, "
-                       "costs in {}{}\n",
+                       "costs in {}{}{}\n{}",
                        r.scene, r.primitives, r.test_rays, r.distribution, split, kinds, estimator_name(est),
                        preset_name(r.presets.front()), r.calibrated ? "ns (calibrated)" : "operations",
+                       est == Estimator::Geometric
+                           ? "; P of a hit in a region of several primitives by the Poisson form 1 - exp(-sum p_i)"
+                           : "",
                        rough(r) ? "; with early termination this estimator is a rough guide (docs/model-accuracy.md)"
-                                : "");
+                                : "",
+                       left_out);
 }
 
 std::string eval_summary(const EvalResult& r, bool by_depth) {

@@ -52,7 +52,7 @@ protected:
 };
 
 const Registration reg{{"brute", "every primitive tested for every ray (the reference)", {},
-                        [](const Scene& s, const Params&) { return std::make_unique<Brute>(s); }}};
+                        [](const Scene& s, const Params&) { return std::make_unique<Brute>(s); }, kBruteInAll}};
 
 }  // namespace
 }  // namespace rtcost

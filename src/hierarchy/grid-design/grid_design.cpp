@@ -88,7 +88,8 @@ const Registration reg{
          std::vector<Candidate> tried = search_resolution(s, in, assign, mailbox, max_cells);
          auto g = std::make_unique<Grid>(s, tried.front().res, assign, mailbox);
          return std::make_unique<GridDesign>(s, std::move(g), std::move(tried));
-     }}};
+     },
+     kLargeScene}};  // each candidate grid's model tree holds two nodes per cell: minutes for a million
 
 }  // namespace
 }  // namespace rtcost::grid

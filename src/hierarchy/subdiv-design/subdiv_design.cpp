@@ -35,7 +35,8 @@ const Registration octree_reg{
      specs(12, octree::kMaxDepth, 1),
      [](const Scene& s, const Params& p) {
          return build<octree::Octree, octree::Options>(s, p, octree::kMaxDepth, 3, "octree-design");
-     }}};
+     },
+     kLargeScene}};  // every candidate split replayed on the sample: 10 s for a million triangles
 
 const Registration bsp_reg{
     {"bsp-design", "Kaplan's BSP tree, a cell split only where the cost model with a sample of the given rays says it pays",
