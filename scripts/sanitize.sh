@@ -23,7 +23,7 @@ configure() {
 }
 
 asan="-fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all -fsanitize=fuzzer-no-link"
-configure build-asan "$asan" -DRTCOST_FUZZ=ON
+configure build-asan "$asan" -DRTCOST_FUZZ=ON -DRTCOST_BUILD_PYTHON=OFF
 start=$(date +%s)
 cmake --build build-asan -j "$jobs" --target rtcost_tests rtcost_cli
 echo "sanitize: asan build $(t "$start") s"

@@ -132,7 +132,9 @@ TEST(EvalView, TheDefaultCameraFramesAThinMesh) {
     }
     s.finalize();
     auto h2 = build_hierarchy(s, "brute");
-    const auto rays = camera_rays(s.camera, 64, 64);
+    // The image's aspect follows the plate's projected extent (512 on its long side).
+    EXPECT_EQ(std::max(s.camera.width, s.camera.height), 512);
+    const auto rays = camera_rays(s.camera, s.camera.width / 8, s.camera.height / 8);
     std::size_t hits = 0;
     for (const Ray& r : rays) {
         Hit hit;
@@ -140,9 +142,16 @@ TEST(EvalView, TheDefaultCameraFramesAThinMesh) {
         hits += hit.hit();
     }
     EXPECT_GT(hits, rays.size() / 3) << hits << " of " << rays.size();
-    // Every corner of the box is in view.
+    // Every corner of the box is in view: inside the frustum of the angle (which spans the rows'
+    // centres) and the aspect.
     const Vec3 fwd = normalize(s.camera.at - s.camera.from);
-    for (const Vec3& q : p) EXPECT_GT(dot(normalize(q - s.camera.from), fwd), std::cos(0.5 * 45 * 3.14159265 / 180) - 1e-3);
+    const Vec3 right = normalize(cross(fwd, s.camera.up)), up = cross(right, fwd);
+    const double tan_v = std::tan(0.5 * 45 * 3.14159265 / 180), tan_h = tan_v * s.camera.width / s.camera.height;
+    for (const Vec3& q : p) {
+        const Vec3 v = q - s.camera.from;
+        EXPECT_LE(std::fabs(dot(v, right)) / dot(v, fwd), tan_h * 1.001);
+        EXPECT_LE(std::fabs(dot(v, up)) / dot(v, fwd), tan_v * 1.001);
+    }
 }
 
 }  // namespace

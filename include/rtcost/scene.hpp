@@ -136,6 +136,9 @@ public:
     void finalize();
 
 private:
+    /// The camera finalize() gives a scene without one: centred on `centre`, the bounds' radius.
+    Camera default_camera(Vec3 centre, float radius) const;
+
     Box3 bounds_;
     std::vector<PrimSummary> summaries_;
 };
