@@ -14,6 +14,7 @@ export CCACHE_NOHASHDIR=1
 flags="-fno-omit-frame-pointer -fsanitize=address,undefined -fno-sanitize-recover=all -fsanitize=fuzzer-no-link"
 if [ ! -f $b/build.ninja ]; then  # the same configuration as scripts/sanitize.sh
   CC=clang CXX=clang++ cmake -S . -B $b -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O2 -gline-tables-only -DNDEBUG" \
     -DCMAKE_CXX_FLAGS="$flags" -DRTCOST_FUZZ=ON -DRTCOST_BUILD_BENCH=OFF -DRTCOST_BUILD_PYTHON=OFF \
     $(command -v ccache >/dev/null && echo -DCMAKE_CXX_COMPILER_LAUNCHER=ccache) > /dev/null
 fi
