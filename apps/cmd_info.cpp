@@ -37,7 +37,7 @@ int cmd_build(const BuildArgs& a, const Common& common) {
         json j = {{"scene", scene.name},
                   {"primitives", scene.size()},
                   {"hierarchy", h->name()},
-                  {"params", Params(find_hierarchy(h->name())->params, a.set).values()},
+                  {"params", params_json(Params(find_hierarchy(h->name())->params, a.set).values())},
                   {"build", to_json(s)}};
         std::cout << j.dump(2) << "\n";
         return 0;
@@ -59,7 +59,7 @@ int cmd_list(const Common& common) {
         for (const HierarchyInfo* h : hierarchies()) {
             json params = json::array();
             for (const ParamSpec& p : h->params)
-                params.push_back({{"name", p.name}, {"default", p.default_value}, {"help", p.help}});
+                params.push_back({{"name", p.name}, {"default", param_json(p.default_value)}, {"help", p.help}});
             hs.push_back({{"name", h->name}, {"description", h->description}, {"params", params}});
         }
         json scenes = json::array();

@@ -72,7 +72,7 @@ int cmd_trace(const TraceArgs& a, const Common& common) {
             trace["shadow_query"] = a.shadow;
         if (counted) trace["per_ray"] = per_ray_json(counted->counters);
         json j = {{"scene", scene.name}, {"primitives", scene.size()}, {"hierarchy", h->name()},
-                  {"params", Params(find_hierarchy(h->name())->params, a.b.set).values()},
+                  {"params", params_json(Params(find_hierarchy(h->name())->params, a.b.set).values())},
                   {"build", to_json(s)},  {"trace", trace}};
         std::cout << j.dump(2) << "\n";
         return 0;

@@ -223,7 +223,7 @@ TEST(Cli, BuildPrintsStructure) {
     EXPECT_EQ(j["build"]["N_IN"], 63);
     EXPECT_EQ(j["build"]["N_OIV"], 64);
     EXPECT_EQ(j["build"]["depth"], 6);
-    EXPECT_EQ(j["params"]["max_prims"], "1");
+    EXPECT_EQ(j["params"]["max_prims"], 1);  // typed: a number, not the text "1"
 }
 
 TEST(Cli, QuietAndPipedOutputHasNoProgressNoise) {

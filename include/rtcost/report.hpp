@@ -4,6 +4,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <map>
 #include <nlohmann/json.hpp>
 #include <string>
 
@@ -14,6 +15,11 @@ namespace rtcost {
 
 /// `{"N_IN", "N_V", "N_EV", "N_OIV", "depth", "bytes", "seconds"}`.
 nlohmann::json to_json(const StructureStats& s);
+/// A hierarchy parameter's value as JSON: a number when the whole text is one ("8", "0.2"),
+/// otherwise the text ("woo", "auto").
+nlohmann::json param_json(const std::string& value);
+/// Every parameter of a build, typed as by param_json.
+nlohmann::json params_json(const std::map<std::string, std::string>& values);
 /// Per-ray means: `{"N_IT", "N_TS", "N_ETS", "N_EETS", "box", "plane", "hop", "classify",
 /// "prim", "prim_by_kind": {...}, "visits_by_depth": [...]}` (divided by `c.rays`).
 nlohmann::json per_ray_json(const RayCounters& c);

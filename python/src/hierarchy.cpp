@@ -83,7 +83,7 @@ PyTrace trace_py(const PyHierarchy& ph, const pb::array& rays, const pb::object&
 }
 
 nlohmann::json params_json(const PyHierarchy& ph) {
-    return Params(find_hierarchy(ph.h->name())->params, ph.set).values();
+    return rtcost::params_json(Params(find_hierarchy(ph.h->name())->params, ph.set).values());
 }
 
 }  // namespace
@@ -133,7 +133,7 @@ void bind_hierarchy(pb::module_& m) {
             for (const HierarchyInfo* info : hierarchies()) {
                 pb::list params;
                 for (const ParamSpec& p : info->params)
-                    params.append(pb::dict(pb::arg("name") = p.name, pb::arg("default") = p.default_value,
+                    params.append(pb::dict(pb::arg("name") = p.name, pb::arg("default") = to_python(param_json(p.default_value)),
                                            pb::arg("help") = p.help));
                 out.append(pb::dict(pb::arg("name") = info->name, pb::arg("description") = info->description,
                                     pb::arg("params") = params));

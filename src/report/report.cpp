@@ -1,5 +1,8 @@
 #include "rtcost/report.hpp"
 
+#include <charconv>
+#include <cmath>
+
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -9,6 +12,24 @@ nlohmann::json to_json(const StructureStats& s) {
     nlohmann::json j = {{"N_IN", s.interior}, {"N_V", s.leaves},  {"N_EV", s.empty_leaves}, {"N_OIV", s.references},
                         {"depth", s.depth},   {"bytes", s.bytes}, {"seconds", s.seconds}};
     if (!s.limits.empty()) j["limits"] = s.limits;
+    return j;
+}
+
+nlohmann::json param_json(const std::string& value) {
+    const char* first = value.data();
+    const char* last = first + value.size();
+    long long i = 0;
+    if (auto [end, ec] = std::from_chars(first, last, i); ec == std::errc() && end == last && !value.empty()) return i;
+    double d = 0;
+    if (auto [end, ec] = std::from_chars(first, last, d); ec == std::errc() && end == last && !value.empty() &&
+                                                          std::isfinite(d))
+        return d;
+    return value;
+}
+
+nlohmann::json params_json(const std::map<std::string, std::string>& values) {
+    nlohmann::json j = nlohmann::json::object();
+    for (const auto& [k, v] : values) j[k] = param_json(v);
     return j;
 }
 
