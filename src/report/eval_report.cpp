@@ -97,7 +97,7 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
 }
 
 std::string eval_columns() {
-    return fmt::format("{:<12} {:>9} {:>9} {:>10} {:>11} {:>11} {:>8} {:>10} {:>7} {:>9}\n", "hierarchy", "build s",
+    return fmt::format("{:<14} {:>9} {:>9} {:>10} {:>11} {:>11} {:>8} {:>10} {:>7} {:>9}\n", "hierarchy", "build s",
                        "nodes", "bytes", "predicted", "counted", "error", "ns/ray", "spread", "Mrays/s");
 }
 
@@ -112,7 +112,7 @@ std::string limit_lines(const StructureStats& s) {
 
 std::string eval_row(const EvalRow& row) {
     const Prediction* head = row.headline();
-    return fmt::format("{:<12} {:>9.4f} {:>9} {:>10} {:>11} {:>11} {:>8} {:>10.1f} {:>7} {:>9.3f}\n", row.name,
+    return fmt::format("{:<14} {:>9.4f} {:>9} {:>10} {:>11} {:>11} {:>8} {:>10.1f} {:>7} {:>9.3f}\n", row.name,
                        row.structure.seconds, row.structure.interior + row.structure.leaves,
                        human_bytes(row.structure.bytes), head ? fmt::format("{:.2f}", head->scalar) : "-",
                        row.counted ? fmt::format("{:.2f}", row.measured_scalar) : "-",
@@ -176,12 +176,12 @@ std::string eval_summary(const EvalResult& r, bool by_depth) {
         if (!row.counted) print("{} is timed only: its operations are not counted and it is not modelled\n", row.name);
     }
     if (!r.rows.empty() && r.rows[0].predictions.size() > 1) {
-        print("\nevery prediction (cost per ray, error; seconds to predict):\n{:<12}", "hierarchy");
+        print("\nevery prediction (cost per ray, error; seconds to predict):\n{:<14}", "hierarchy");
         for (const Prediction& p : r.rows[0].predictions) print(" {:>30}", p.estimator + "/" + p.preset);
         print("\n");
         for (const EvalRow& row : r.rows) {
             if (!row.modelled) continue;
-            print("{:<12}", row.name);
+            print("{:<14}", row.name);
             for (const Prediction& p : row.predictions)
                 print(" {:>30}", fmt::format("{:.2f} ({:+.1f}%; {:.3f} s)", p.scalar,
                                              100 * relative(p.scalar, row.measured_scalar), p.seconds));
@@ -195,7 +195,7 @@ std::string eval_summary(const EvalResult& r, bool by_depth) {
         for (const EvalRow& row : r.rows) {
             if (!row.modelled) continue;
             const double p = row.headline()->scalar;
-            print("{:<12} predicted {:10.1f} ns  measured {:10.1f} ns  {:+.1f}%\n", row.name, p, row.ns_per_ray,
+            print("{:<14} predicted {:10.1f} ns  measured {:10.1f} ns  {:+.1f}%\n", row.name, p, row.ns_per_ray,
                   100 * relative(p, row.ns_per_ray));
         }
     }
@@ -203,7 +203,7 @@ std::string eval_summary(const EvalResult& r, bool by_depth) {
     for (const EvalRow& row : r.rows) {
         if (!row.modelled) continue;
         const CostVector &p = row.headline()->cost, &m = row.measured;
-        print("{:<12} box {:.2f}/{:.2f}  plane {:.2f}/{:.2f}  hop {:.2f}/{:.2f}  classify {:.2f}/{:.2f}  prim "
+        print("{:<14} box {:.2f}/{:.2f}  plane {:.2f}/{:.2f}  hop {:.2f}/{:.2f}  classify {:.2f}/{:.2f}  prim "
               "{:.2f}/{:.2f}  N_TS {:.2f}/{:.2f}\n",
               row.name, p.box, m.box, p.plane, m.plane, p.hop, m.hop, p.classify, m.classify, p.prim_tests(),
               m.prim_tests(), p.steps, m.steps);
