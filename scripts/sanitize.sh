@@ -36,7 +36,11 @@ export LSAN_OPTIONS="suppressions=$PWD/scripts/lsan.supp"
 # hierarchy against brute force, 100k+ rays each: "SceneCheck*" alone missed the Builtin/ and
 # Mesh/ instances, which ran for over ten minutes under ASan) and the README's commands; the
 # Release suite runs them. Two shards in parallel, one per core.
+# Also left out: the longest exactness checks on built-in scenes (BspOctreeHits, BspOctreeModel,
+# KdModel: every hierarchy's code is under ASan through the shorter tests of the same families)
+# and the CLI's whole-eval test, to hold CI's time.
 slow="*Spd*:*SceneCheck*:ModelExactness.*:AdversarialBounds.SpdScenesAreNotLimited:Readme.*"
+slow="$slow:BspOctreeHits.*:BspOctreeModel.*:KdModel.*:CliModel.*"
 # Every other test that reads ../shared's SPD scenes (the designs on gears and tree, ...) skips
 # as on a machine without them: under ASan they took most of the suite's time and 10 GB.
 export RTCOST_SHARED=/nonexistent-for-the-sanitizer-run

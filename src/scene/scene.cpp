@@ -200,7 +200,9 @@ struct Rasterizer {
     double r0, u0, w, h;
 
     int cell(double v, double lo, double span) const {
-        return std::clamp(static_cast<int>(std::floor((v - lo) / span * kRaster)), 0, kRaster - 1);
+        const double x = (v - lo) / span * kRaster;
+        if (!(x >= 0)) return 0;  // below the frame, or NaN (a degenerate primitive's bounds)
+        return x >= kRaster - 1 ? kRaster - 1 : static_cast<int>(x);
     }
     double centre_r(int i) const { return r0 + (i + 0.5) * w / kRaster; }
     double centre_u(int j) const { return u0 + (j + 0.5) * h / kRaster; }
