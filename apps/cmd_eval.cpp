@@ -108,7 +108,7 @@ Subcommand setup_eval(CLI::App& parent, Common& common) {
     auto a = std::make_shared<EvalArgs>();
     auto* eval = parent.add_subcommand("eval", "predict each hierarchy's cost with the model and measure it");
     eval->add_option("SCENE", a->scene, "scene file or builtin:NAME[:level]")->required();
-    eval->add_option("-H,--hierarchy", a->hierarchies, "comma-separated hierarchies, or all")->capture_default_str();
+    eval->add_option("-H,--hierarchy", a->hierarchies, "comma-separated hierarchies (name[:key=value...]), or all: those that make sense at the scene's size (the header names what it left out)")->capture_default_str();
     eval->add_option("--set", a->set, "parameter key=value for a single hierarchy (repeatable)");
     add_ray_args(eval, a->rays);
     eval->add_option("--query", a->query, "closest, any, or all (no early termination)")

@@ -96,7 +96,7 @@ Subcommand setup_report(CLI::App& parent, Common& common) {
     auto* cmd = parent.add_subcommand("report", "evaluate hierarchies and write one self-contained HTML page: the "
                                                 "table, plots of predicted against measured cost, heat maps");
     cmd->add_option("SCENE", a->scene, "scene file or builtin:NAME[:level]")->required();
-    cmd->add_option("-H,--hierarchy", a->hierarchies, "comma-separated hierarchies, or all")->capture_default_str();
+    cmd->add_option("-H,--hierarchy", a->hierarchies, "comma-separated hierarchies (name[:key=value...]), or all: those that make sense at the scene's size (the header names what it left out)")->capture_default_str();
     add_ray_args(cmd, a->rays);
     cmd->add_option("--estimator", a->estimator, "the model's estimator: geometric, sampled or segments")
         ->check(CLI::IsMember({"geometric", "sampled", "segments"}))
