@@ -4,7 +4,9 @@
 # starting from fuzz/corpus/<name>/. Findings go to build-asan/findings/ and fail the script.
 # Long run: scripts/fuzz.sh 3600 (an hour each), or one harness: FUZZERS=trace scripts/fuzz.sh
 # 36000. New corpus entries stay in build-asan/corpus/ (copy small interesting ones into
-# fuzz/corpus/ by hand).
+# fuzz/corpus/ by hand). FUZZ_SEED=N fixes libFuzzer's seed: the same inputs in the same order
+# on every machine (CI uses it, so that its result does not depend on the draw; long runs draw
+# a new seed each time to explore further).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
@@ -28,7 +30,7 @@ export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 for f in $fuzzers; do
   mkdir -p "$b/corpus/$f"
   echo "fuzz: $f for ${seconds}s"
-  if ! $b/fuzz/fuzz_$f -max_total_time="$seconds" -timeout=120 -rss_limit_mb=3072 -max_len=4096 \
+  if ! $b/fuzz/fuzz_$f ${FUZZ_SEED:+-seed=$FUZZ_SEED} -max_total_time="$seconds" -timeout=120 -rss_limit_mb=3072 -max_len=4096 \
       -artifact_prefix="$b/findings/$f-" -print_final_stats=1 \
       "$b/corpus/$f" "fuzz/corpus/$f" 2> "$b/fuzz-$f.log"; then
     echo "fuzz: $f FOUND a problem ($b/fuzz-$f.log, $b/findings/)"; tail -40 "$b/fuzz-$f.log"

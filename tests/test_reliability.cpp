@@ -373,5 +373,42 @@ TEST(Reliability, CoplanarOverlappingTrianglesAreTiesNotMisses) {
     }
 }
 
+TEST(Reliability, DenormalDirectionComponentsAreParallelInEveryHierarchy) {
+    // The ray fuzzer's finding (CI, 64 bytes): a direction with a y component of -6.9e-41, whose
+    // reciprocal overflows to -inf, from an origin in the grid's plane y = 0. The grid stepped
+    // that axis with NaN crossings and skipped cells: a miss where brute force hits primitive 5.
+    // Around it: denormal and zero components of both signs on each axis, from origins in the
+    // planes through the scene's centre (where a grid of even resolution has its planes).
+    const Scene s = builtin_scene("balls", 1);
+    std::vector<Ray> rays = {Ray{{5.620217570e-37f, 0, 0.5f}, {-5, -6.887662e-41f, 0.50000376f}, 0, 1.7014118e38f}};
+    const Vec3 c = s.bounds().center();
+    const float tiny[] = {6.9e-41f, -6.9e-41f, 1e-45f, -1e-45f, 0.0f, -0.0f};
+    std::vector<Ray> from = random_rays(s.bounds(), 64, 41);
+    for (std::size_t i = 0; i < from.size(); ++i) {
+        Ray r = from[i];
+        const int a = static_cast<int>(i % 3);
+        r.o[a] = c[a];                                     // in the central plane of axis a
+        r.d = s.prim_bounds(static_cast<std::uint32_t>(i % s.size())).center() - r.o;  // aimed at a primitive
+        r.d[a] = tiny[i % 6];
+        rays.push_back(r);
+    }
+    TraceOptions opt;
+    opt.threads = 1;
+    const std::vector<Hit> want = trace_rays(*build_hierarchy(s, "brute"), rays, opt).hits;
+    ASSERT_EQ(want[0].prim, 5);
+    std::size_t hits = 0;
+    for (const Hit& h : want) hits += h.hit();
+    EXPECT_GT(hits, 20u);
+    for (const HierarchyInfo* info : hierarchies()) {
+        if (info->name == "embree" || info->name == "brute") continue;
+        SCOPED_TRACE(info->name);
+        const std::vector<Hit> got = trace_rays(*build_hierarchy(s, info->name), rays, opt).hits;
+        for (std::size_t i = 0; i < rays.size(); ++i) {
+            EXPECT_EQ(want[i].prim, got[i].prim) << "ray " << i;
+            EXPECT_EQ(want[i].t, got[i].t) << "ray " << i;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace rtcost::test

@@ -12,6 +12,7 @@
 // primitive test (with mailbox=1 only real tests are counted).
 
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <span>
 #include <string>
@@ -110,14 +111,19 @@ private:
         float tnext[3];
         for (int a = 0; a < 3; ++a) {
             const int r = res_[a];
-            if (ray.d[a] > 0) {
+            // A component whose reciprocal overflows (|d| below about 3e-39, a denormal) is taken
+            // as parallel to the axis, as the slab test (box_entry) and so every box-based
+            // hierarchy takes it; stepping it would give NaN crossings (0 * inf) that misorder
+            // the exits and skip cells.
+            const bool moves = std::isfinite(ri.inv[a]);
+            if (moves && ray.d[a] > 0) {
                 int i = guess(a, ri.o[a] + t0 * ri.d[a]);
                 while (i < r - 1 && cross(a, i + 1, ri) <= t0) ++i;
                 while (i > 0 && cross(a, i, ri) > t0) --i;
                 idx[a] = i;
                 step[a] = 1;
                 tnext[a] = cross(a, i + 1, ri);
-            } else if (ray.d[a] < 0) {
+            } else if (moves && ray.d[a] < 0) {
                 int i = guess(a, ri.o[a] + t0 * ri.d[a]);
                 while (i > 0 && cross(a, i, ri) <= t0) --i;
                 while (i < r - 1 && cross(a, i + 1, ri) > t0) ++i;
