@@ -46,6 +46,8 @@ struct BuildArgs {
 void add_build_args(CLI::App* cmd, BuildArgs& a);
 /// Warns on stderr (unless quiet) of every bound that stopped a build (StructureStats::limits).
 void print_limits(const StructureStats& s, const Common& common);
+/// Warnings (a scene's skipped input, a ray set's far rays) to stderr, the first five, unless quiet.
+void print_warnings(const std::vector<std::string>& warnings, bool quiet);
 /// Builds with a note on a terminal while it runs, then warns of the bounds that stopped it
 /// (for a lazily built hierarchy, call print_limits after tracing).
 std::unique_ptr<Hierarchy> build(const Scene& scene, const BuildArgs& a, const Common& common);

@@ -42,21 +42,17 @@ void add_view_args(CLI::App* cmd, ViewSpec& view) {
 
 Query parse_query(const std::string& q) { return q == "any" ? Query::Any : q == "all" ? Query::All : Query::Closest; }
 
-namespace {
-/// Warnings gathered while loading (degenerate primitives skipped), to stderr unless quiet.
-void print_warnings(const Scene& scene, bool quiet) {
-    if (quiet || scene.warnings.empty()) return;
+void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
+    if (quiet || warnings.empty()) return;
     constexpr std::size_t kShown = 5;
-    for (std::size_t i = 0; i < scene.warnings.size() && i < kShown; ++i)
-        fmt::print(stderr, "rtcost: warning: {}\n", scene.warnings[i]);
-    if (scene.warnings.size() > kShown)
-        fmt::print(stderr, "rtcost: warning: ... and {} more\n", scene.warnings.size() - kShown);
+    for (std::size_t i = 0; i < warnings.size() && i < kShown; ++i)
+        fmt::print(stderr, "rtcost: warning: {}\n", warnings[i]);
+    if (warnings.size() > kShown) fmt::print(stderr, "rtcost: warning: ... and {} more\n", warnings.size() - kShown);
 }
-}  // namespace
 
 Scene load(const std::string& spec, const Common& common, const ViewSpec& view) {
     Scene scene = load_scene(spec);
-    print_warnings(scene, common.quiet || common.json);
+    print_warnings(scene.warnings, common.quiet || common.json);
     apply_view(scene, view);
     return scene;
 }

@@ -52,6 +52,7 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     auto measure = [&](const std::string& spec, std::vector<CalibrationSample>& into, std::vector<std::string>* scene_of) {
         Scene scene = load(spec, common, a.rays.view);
         RaySet rays = make_rays(scene, a.rays);
+        print_warnings(rays.warnings, common.quiet || common.json);
         for (const HierarchyRequest& req : names) {
             auto h = build_hierarchy(scene, req.name, req.params);
             if (!h->counted()) continue;  // Embree's operations are not counted

@@ -32,6 +32,7 @@ int cmd_rays(const RaysArgs& a, const Common& common) {
     } else {
         set = make_rays(scene, a.spec);
     }
+    print_warnings(set.warnings, common.quiet || common.json);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!a.out.empty()) write_rays(a.out, set.rays);
 

@@ -22,6 +22,7 @@ int cmd_trace(const TraceArgs& a, const Common& common) {
     if (!a.hits_out.empty()) check_output_path(a.hits_out, "--hits");
     Scene scene = load(a.b.scene, common, a.rays.view);
     RaySet rays = make_rays(scene, a.rays);
+    print_warnings(rays.warnings, common.quiet || common.json);
     auto h = build(scene, a.b, common);
     StructureStats s = h->structure();
 

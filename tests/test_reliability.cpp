@@ -440,5 +440,45 @@ TEST(Reliability, ATangentHitAtTheSegmentStartIsFoundFromTminZero) {
     }
 }
 
+TEST(Reliability, RaysAreExactUpToTheResolvedDistanceAndWarnedAboutBeyondIt) {
+    // The ray fuzzer's third finding: a ray grazing the top of balls' central sphere from 1.4e11
+    // away (5.7e9 scene sizes). There float t has a resolution of 2048, every crossing of the
+    // scene rounds to one value, and the cell walks missed the grazing hit. rtcost promises exact
+    // hits up to kMaxResolvedDistance scene sizes and warns beyond it: the same grazing ray from
+    // that distance gives brute force's hit in every hierarchy, and a file holding the far ray
+    // makes a warning that names it.
+    const Scene s = builtin_scene("balls", 1);
+    const Vec3 e = s.bounds().extent();
+    const float size = std::max({e.x, e.y, e.z});
+    const float edge = s.bounds().hi.x + kMaxResolvedDistance * size * 0.999f;
+    const std::vector<Ray> rays = {Ray{{edge, 0, 0.5f}, {-5, 2.2958874e-41f, -0.0f}, 1, kInf},
+                                   Ray{{137438953472.0f, 0, 0.5f}, {-5, 2.2958874e-41f, -0.0f}, 1, kInf}};
+    EXPECT_FALSE(starts_too_far(s.bounds(), rays[0]));
+    EXPECT_TRUE(starts_too_far(s.bounds(), rays[1]));
+    TraceOptions opt;
+    opt.threads = 1;
+    const Hit want = trace_rays(*build_hierarchy(s, "brute"), std::span(rays.data(), 1), opt).hits[0];
+    ASSERT_EQ(want.prim, 1);
+    for (const HierarchyInfo* info : hierarchies()) {
+        if (info->name == "embree" || info->name == "brute") continue;
+        SCOPED_TRACE(info->name);
+        const Hit got = trace_rays(*build_hierarchy(s, info->name), std::span(rays.data(), 1), opt).hits[0];
+        EXPECT_EQ(got.prim, want.prim);
+        EXPECT_EQ(got.t, want.t);
+    }
+    const fs::path near = scratch() / "near.rays", far = scratch() / "far.rays";
+    write_file(near, ray_bytes({rays[0]}));
+    write_file(far, ray_bytes(rays));
+    RaySpec spec;
+    spec.name = near.string();
+    EXPECT_TRUE(make_rays(s, spec).warnings.empty());
+    spec.name = far.string();
+    const std::vector<std::string> w = make_rays(s, spec).warnings;
+    ASSERT_EQ(w.size(), 1u);
+    EXPECT_TRUE(contains(w[0], "1 rays (the first: ray 1) start more than 100000 scene sizes away")) << w[0];
+    fs::remove(near);
+    fs::remove(far);
+}
+
 }  // namespace
 }  // namespace rtcost::test

@@ -50,7 +50,18 @@ struct RaySet {
     std::string described;        ///< e.g. "camera 512x512"
     /// Counts by kind (and, for generated trees, hits by kind), for reports.
     std::vector<std::pair<std::string, std::size_t>> summary;
+    /// Problems worth telling the user that do not make the set invalid (rays too far away).
+    std::vector<std::string> warnings;
 };
+
+/// How far from a scene, in units of its size (the largest side of its bounds), a ray may start
+/// and still be traced exactly: float positions along the ray resolve the scene to about 1/100
+/// of its size up to there. Farther, cell walks can no longer order their crossings, grazing
+/// hits become rounding noise, and hierarchies may disagree with brute force.
+inline constexpr float kMaxResolvedDistance = 1e5f;
+
+/// Whether `ray` starts more than kMaxResolvedDistance scene sizes outside `bounds`.
+bool starts_too_far(const Box3& bounds, const Ray& ray);
 
 /// A camera and lights given on the command line instead of the scene's: `camera` is
 /// "fx,fy,fz,ax,ay,az,ux,uy,uz,fov" (from, at, up, full field of view in degrees), each light

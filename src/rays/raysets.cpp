@@ -111,7 +111,27 @@ RaySet make_rays(const Scene& scene, const RaySpec& spec) {
         for (const auto& n : distribution_names()) names += (names.empty() ? "" : ", ") + n;
         throw InputError(spec.name, 0, "no such file, and not a distribution (" + names + ")");
     }
-    return uniform(read_rays(spec.name), RayKind::File, spec.name);
+    RaySet set = uniform(read_rays(spec.name), RayKind::File, spec.name);
+    std::size_t far = 0, first = 0;
+    for (std::size_t i = set.rays.size(); i-- > 0;)
+        if (starts_too_far(scene.bounds(), set.rays[i])) ++far, first = i;
+    if (far)
+        set.warnings.push_back(fmt::format("{}: {} rays (the first: ray {}) start more than {:g} scene sizes away; "
+                                           "float positions cannot resolve the scene there, so hits may be rounding "
+                                           "noise and hierarchies may disagree with brute force",
+                                           spec.name, far, first, kMaxResolvedDistance));
+    return set;
+}
+
+bool starts_too_far(const Box3& bounds, const Ray& ray) {
+    const Vec3 e = bounds.extent();
+    const double size = std::max({e.x, e.y, e.z});
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+        const double out = std::max({0.0, double(bounds.lo[a]) - ray.o[a], double(ray.o[a]) - bounds.hi[a]});
+        d2 += out * out;
+    }
+    return std::sqrt(d2) > double(kMaxResolvedDistance) * size;
 }
 
 }  // namespace rtcost
