@@ -4,6 +4,7 @@
 #include <iostream>
 
 #include "cli.hpp"
+#include "rtcost/design.hpp"
 #include "rtcost/evaluate.hpp"
 #include "rtcost/html_report.hpp"
 
@@ -15,7 +16,7 @@ struct ReportArgs {
     std::string scene;
     std::string hierarchies = "all";
     RaySpec rays;
-    std::string estimator = "sampled";
+    std::string estimator = "segments";  // eval's default: the most accurate that costs no full trace
     std::string costs;
     std::string from_eval;
     std::string heatmap = "ops";
@@ -23,6 +24,7 @@ struct ReportArgs {
     double scale_max = 0;
     bool log = false;
     int threads = 0;
+    bool no_design = false;
     std::string out = "report.html";
 };
 
@@ -42,6 +44,23 @@ json run_eval(const ReportArgs& a, const Scene& scene, const UnitCosts& costs, c
     const EvalResult r = evaluate(scene, a.rays, opt);
     progress.finish();
     return to_json(r, true);
+}
+
+json run_design(const ReportArgs& a, const Scene& scene, const Common& common) {
+    DesignOptions opt;
+    opt.rays = a.rays;
+    opt.seed = a.rays.seed;
+    opt.costs_file = a.costs;
+    // Three builds per family: the designed hierarchy, its yardstick and Embree.
+    const std::size_t builds = 3 * design_families().size();
+    Progress progress("report: design", builds, common.quiet || common.json);
+    std::size_t done = 0;
+    opt.on_step = [&](const std::string& step) {
+        if (step.rfind("build ", 0) == 0) progress.update(std::min(done++, builds));
+    };
+    const DesignResult r = design(scene, opt);
+    progress.finish();
+    return to_json(r);
 }
 
 json read_eval(const std::string& path) {
@@ -78,6 +97,7 @@ int cmd_report(const ReportArgs& a, const Common& common) {
         heat.on_step = [&](const std::string&) { progress.update(done++); };
         add_heatmaps(in, scene, labels, heat);
     }
+    if (!a.no_design) in.design = run_design(a, scene, common);
     add_render(in, scene, heat.width, heat.height, a.threads);
     const std::string html = report_html(in);
     write_file_atomic(a.out, html);
@@ -85,8 +105,9 @@ int cmd_report(const ReportArgs& a, const Common& common) {
         std::cout << report_json(in).dump(2) << "\n";
         return 0;
     }
-    fmt::print("report     {}: {} hierarchies, {} heat maps ({}), {}\n", scene.name, labels.size(), in.heatmaps.size(),
-               a.heatmap, in.eval.value("distribution", "?"));
+    fmt::print("report     {}: {} hierarchies, {} heat maps ({}), {}{}\n", scene.name, labels.size(), in.heatmaps.size(),
+               a.heatmap, in.eval.value("distribution", "?"),
+               in.design.is_object() ? fmt::format(", {} designed families", in.design["results"].size()) : "");
     fmt::print("written    {} ({})\n", a.out, human_bytes(html.size()));
     return 0;
 }
@@ -111,6 +132,8 @@ Subcommand setup_report(CLI::App& parent, Common& common) {
         ->check(CLI::PositiveNumber);
     cmd->add_flag("--log-scale", a->log, "heat map colours by log(1 + value), for costs that span decades");
     cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024));
+    cmd->add_flag("--no-design", a->no_design, "leave out the design section (each family's hierarchy designed for "
+                                               "the rays against its yardstick, as `rtcost design` runs it)");
     cmd->add_option("-o,--out", a->out, "HTML file to write")->capture_default_str();
     add_common(cmd, common);
     cmd->footer(hierarchy_help());

@@ -7,6 +7,7 @@
 
 
 #include "report_test_util.hpp"
+#include "rtcost/design.hpp"
 #include "rtcost/error.hpp"
 #include "rtcost/html_report.hpp"
 #include "rtcost/io.hpp"
@@ -143,6 +144,40 @@ TEST(ReportHtml, SelfContainedWithTableImagesAndPlots) {
     EXPECT_FALSE(data["meta"]["machine"]["os"].get<std::string>().empty());
 }
 
+TEST(ReportHtml, ADesignSectionWithTheDesignsNumbers) {
+    if (!report_scripts_available()) GTEST_SKIP() << "built without Vega-Lite (scripts/install-deps.sh)";
+    const Scene scene = load_scene("builtin:balls:1");
+    DesignOptions opt;
+    opt.rays.size = "32x32";
+    opt.families = {"bvh", "grid"};
+    const DesignResult d = design(scene, opt);
+    ASSERT_EQ(d.rows.size(), 2u);
+    ReportInput in;
+    in.eval = fixture();
+    in.design = to_json(d);
+    const json plots = page_plots(in);
+    ASSERT_TRUE(plots.contains("plot-design"));
+    const json& bars = plots["plot-design"]["data"]["values"];
+    ASSERT_EQ(bars.size(), 6u);  // designed, yardstick and Embree per family
+    EXPECT_EQ(bars[0]["hierarchy"], "bvh-design");
+    EXPECT_DOUBLE_EQ(bars[0]["ns"].get<double>(), d.rows[0].designed_ns);
+    EXPECT_EQ(bars[4]["hierarchy"], "grid:res=hetero");
+    EXPECT_DOUBLE_EQ(bars[4]["ns"].get<double>(), d.rows[1].yardstick_ns);
+    const std::string html = report_html(in);
+    EXPECT_NE(html.find("<h2>Design</h2>"), std::string::npos);
+    EXPECT_NE(html.find("<div class=\"plot\" id=\"plot-design\">"), std::string::npos);
+    for (const DesignRow& row : d.rows) {
+        const std::string cells = fmt::format("<td>{:.2f}</td><td>{:.2f}</td><td>{:.1f}</td><td>{:+.1f}%</td>",
+                                              row.designed_predicted, row.designed_measured, row.designed_ns, 100 * row.gain);
+        EXPECT_NE(html.find(cells), std::string::npos) << cells;
+    }
+    EXPECT_EQ(report_json(in)["design"], in.design);
+    // Without design results, no section.
+    in.design = nullptr;
+    EXPECT_FALSE(page_plots(in).contains("plot-design"));
+    EXPECT_EQ(report_html(in).find("<h2>Design</h2>"), std::string::npos);
+}
+
 TEST(ReportHtml, RejectsAnEvaluationWithoutResults) {
     if (!report_scripts_available()) GTEST_SKIP() << "built without Vega-Lite (scripts/install-deps.sh)";
     ReportInput in;
@@ -156,9 +191,10 @@ TEST(ReportCli, FromASavedEvaluationAndBadInput) {
     fs::remove(out);
     const std::string eval = (fs::path(RTCOST_TEST_DATA) / "eval_balls3.json").string();
     CliRun r = run_cli("report builtin:balls:3 --from-eval " + eval + " --heatmap prim --heatmap-size 24x24 -o " +
-                       out.string() + " --json");
+                       out.string() + " --json --no-design");
     ASSERT_EQ(r.code, 0) << r.err;
     json j = json::parse(r.out);
+    EXPECT_TRUE(j["design"].is_null());
     EXPECT_EQ(j["heatmaps"]["kind"], "prim");
     EXPECT_EQ(j["heatmaps"]["maps"].size(), 4u);
     EXPECT_NE(j["meta"]["command"].get<std::string>().find("report builtin:balls:3"), std::string::npos);

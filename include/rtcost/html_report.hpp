@@ -33,6 +33,8 @@ struct ReportInput {
     nlohmann::json heat = nlohmann::json::object();
     /// {"date", "command", "machine": {...}, "rtcost", "plots"}: see report_meta().
     nlohmann::json meta = nlohmann::json::object();
+    /// The design results (to_json(DesignResult), design.hpp); null: the page has no design section.
+    nlohmann::json design = nullptr;
 };
 
 /// How the report's heat maps are made.
@@ -63,13 +65,21 @@ void add_render(ReportInput& in, const Scene& scene, int width, int height, int 
 nlohmann::json report_meta();
 
 /// The data behind the page (what `rtcost report --json` writes): meta, eval, heat maps'
-/// summaries and the plots' Vega-Lite specifications. Images are left out.
+/// summaries, design results and the plots' Vega-Lite specifications. Images are left out.
 nlohmann::json report_json(const ReportInput& in);
 
 /// The Vega-Lite specifications of the page's plots, by element id: cost by operation kind
 /// (predicted beside measured), predicted against measured (with the ideal line), visits by
 /// depth, and measured speed.
 nlohmann::json report_plots(const nlohmann::json& eval);
+
+/// The design section's plot: each family's designed hierarchy beside its yardstick (and
+/// Embree), in measured single-thread ns per ray on the rays the design did not see.
+nlohmann::json design_plot(const nlohmann::json& design);
+
+/// Every plot of the page for `in`, by element id: report_plots(in.eval), and "plot-design"
+/// when the page has a design section.
+nlohmann::json page_plots(const ReportInput& in);
 
 /// The page. Throws InputError when Vega-Lite was not found at build time (see
 /// report_scripts_available) or the evaluation has no results.

@@ -127,6 +127,26 @@ std::string eval_table(const json& eval) {
     return t + "</tbody></table>\n";
 }
 
+std::string design_table(const json& d) {
+    std::string t = "<table id=\"design\"><thead><tr><th>family</th><th>hierarchy</th><th>structure</th><th>build s</th>"
+                    "<th>predicted</th><th>measured</th><th>ns/ray</th><th>gain</th></tr></thead><tbody>\n";
+    for (const json& r : d.at("results")) {
+        const json &b = r.at("build_seconds"), &p = r.at("predicted"), &m = r.at("measured"), &ns = r.at("ns_per_ray");
+        std::string designed = r.value("designed", "?");
+        for (const json& kv : r.value("set", json::array())) designed.append(":").append(kv.get<std::string>());
+        t += fmt::format("<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td></tr>\n",
+                         esc(r.value("family", "?")), esc(designed), esc(r.value("structure", "")),
+                         num(b.value("designed", json()), "{:.3f}"), num(p.value("designed", json()), "{:.2f}"),
+                         num(m.value("designed", json()), "{:.2f}"), num(ns.value("designed", json()), "{:.1f}"),
+                         num(json(100 * r.value("gain", 0.0)), "{:+.1f}%"));
+        t += fmt::format("<tr><td></td><td>{}</td><td></td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td></td></tr>\n",
+                         esc(r.value("yardstick", "?")), num(b.value("yardstick", json()), "{:.3f}"),
+                         num(p.value("yardstick", json()), "{:.2f}"), num(m.value("yardstick", json()), "{:.2f}"),
+                         num(ns.value("yardstick", json()), "{:.1f}"));
+    }
+    return t + "</tbody></table>\n";
+}
+
 // A picture as a data URI; heat maps carry their title in the image, so only the render has a caption.
 std::string figure(const ReportImage& img, const std::string& cls, bool caption) {
     return fmt::format("<figure class=\"{}\"><img alt=\"{}\" src=\"data:image/png;base64,{}\">{}</figure>\n", cls,
@@ -144,6 +164,7 @@ figure.render img { border: 1px solid #ccc; }
 table { border-collapse: collapse; font-size: 0.9em; }
 th, td { padding: 3px 9px; border-bottom: 1px solid #e4e4e4; text-align: right; }
 th:first-child, td:first-child { text-align: left; } thead th { border-bottom: 2px solid #999; }
+#design td:nth-child(2), #design td:nth-child(3), #design th:nth-child(2), #design th:nth-child(3) { text-align: left; }
 .plots { display: flex; flex-wrap: wrap; gap: 28px; align-items: flex-start; }
 dl { display: grid; grid-template-columns: max-content auto; gap: 2px 14px; font-size: 0.9em; }
 dt { color: #555; } dd { margin: 0; } code { font-size: 0.95em; word-break: break-all; }
@@ -182,7 +203,7 @@ json report_meta() {
 }
 
 json report_json(const ReportInput& in) {
-    return {{"meta", in.meta}, {"eval", in.eval}, {"heatmaps", in.heat}, {"plots", report_plots(in.eval)}};
+    return {{"meta", in.meta}, {"eval", in.eval}, {"heatmaps", in.heat}, {"design", in.design}, {"plots", page_plots(in)}};
 }
 
 std::string report_html(const ReportInput& in) {
@@ -221,10 +242,22 @@ std::string report_html(const ReportInput& in) {
          "; error: (predicted - measured) / measured; ranks: 1 is the cheapest.</p>\n";
 
     h += "<h2>Predicted and measured</h2>\n<div class=\"plots\">\n";
-    const json plots = report_plots(e);
+    const json plots = page_plots(in);
     for (const char* id : {"plot-kinds", "plot-scatter", "plot-depth", "plot-speed"})
         if (plots.contains(id)) h += fmt::format("<div class=\"plot\" id=\"{}\"></div>\n", id);
     h += "</div>\n";
+
+    if (plots.contains("plot-design")) {
+        const json& d = in.design;
+        h += "<h2>Design</h2>\n";
+        h += fmt::format("<p class=\"lead\">Each family's hierarchy designed by the model for {} from a sample of {} "
+                         "rays, against its yardstick builder; predicted: the model on the sample; measured and ns "
+                         "per ray (single thread): on the {} rays the design did not see; gain: 1 - designed / "
+                         "yardstick ns per ray. Costs in {}.</p>\n",
+                         esc(d.value("distribution", "?")), d.value("sample", 0ull), d.value("test_rays", 0ull),
+                         esc(d.value("units", "operations")));
+        h += design_table(d) + "<div class=\"plots\"><div class=\"plot\" id=\"plot-design\"></div></div>\n";
+    }
 
     const json& m = in.meta;
     h += "<h2>Run</h2>\n<dl>\n";

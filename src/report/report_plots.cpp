@@ -143,6 +143,36 @@ json speed(const json& results) {
 
 }  // namespace
 
+json design_plot(const json& design) {
+    json rows = json::array();
+    for (const json& r : design.at("results")) {
+        const json& ns = r.at("ns_per_ray");
+        const std::string family = r.value("family", "?");
+        rows.push_back({{"family", family}, {"hierarchy", r.value("designed", "?")}, {"role", "designed"}, {"ns", ns.value("designed", 0.0)}});
+        rows.push_back({{"family", family}, {"hierarchy", r.value("yardstick", "?")}, {"role", "yardstick"}, {"ns", ns.value("yardstick", 0.0)}});
+        if (ns.value("embree", 0.0) > 0)
+            rows.push_back({{"family", family}, {"hierarchy", "embree"}, {"role", "embree"}, {"ns", ns["embree"]}});
+    }
+    json spec = base("Designed against yardstick: measured ns per ray on rays the design did not see", rows);
+    spec["width"] = {{"step", 18}};
+    spec["height"] = 240;
+    spec["mark"] = {{"type", "bar"}, {"tooltip", true}};
+    spec["encoding"] = {
+        {"x", {{"field", "family"}, {"type", "nominal"}, {"title", nullptr}, {"sort", nullptr}}},
+        {"xOffset", {{"field", "role"}, {"type", "nominal"}, {"sort", {"designed", "yardstick", "embree"}}}},
+        {"y", {{"field", "ns"}, {"type", "quantitative"}, {"title", "single-thread ns per ray"}}},
+        {"color", {{"field", "role"}, {"type", "nominal"}, {"sort", {"designed", "yardstick", "embree"}}, {"title", nullptr}}},
+        {"tooltip", json::array({{{"field", "hierarchy"}}, {{"field", "ns"}, {"format", ".1f"}}})}};
+    return spec;
+}
+
+json page_plots(const ReportInput& in) {
+    json plots = report_plots(in.eval);
+    if (in.design.is_object() && in.design.contains("results") && !in.design["results"].empty())
+        plots["plot-design"] = design_plot(in.design);
+    return plots;
+}
+
 json report_plots(const json& eval) {
     const json& results = eval.at("results");
     const std::string units = eval.value("unit_costs", "operations") == "ns" ? "ns" : "unit costs";
