@@ -126,6 +126,34 @@ TEST(Design, GridDesignIsNoWorseOnItsSampleThanTheFormula) {
     }
 }
 
+TEST(Design, EveryDesignIsNoWorseOnItsSampleThanItsYardstick) {
+    // The split tests look one level down; where the model predicts the yardstick's termination
+    // cheaper on the sample, the designed hierarchy is that tree (design/cheaper.hpp). So on its
+    // own sample no design is predicted worse than its yardstick, and on balls' camera rays,
+    // where the one-level test stops the BSP and the octree far too early, the design is the
+    // yardstick's tree.
+    for (const char* scene : {"builtin:balls:2", "builtin:tetra:3"}) {
+        const Scene s = load_scene(scene);
+        for (const char* rays : {"rays=camera", "rays=shadow"}) {
+            const std::vector<std::string> set{rays, "size=32x32", "sample=512"};
+            Params p(design_param_specs(), set);
+            const DesignInput in = draw_design_input(s, p);
+            for (const auto& [designed, yardstick] : std::vector<std::pair<std::string, std::string>>{
+                     {"bvh-design", "bvh-sah"}, {"kd-design", "kd-sah"}, {"octree-design", "octree"}, {"bsp-design", "bsp"}}) {
+                const double cd = sample_cost(build_hierarchy(s, designed, set)->model_tree(), s, in.sample, in.costs);
+                const double cy = sample_cost(build_hierarchy(s, yardstick)->model_tree(), s, in.sample, in.costs);
+                EXPECT_LE(cd, cy * (1 + 1e-12)) << scene << " " << rays << " " << designed;
+            }
+        }
+    }
+    const Scene balls = builtin_scene("balls", 4);
+    const std::vector<std::string> set{"rays=camera", "size=128x128"};
+    for (const auto& [designed, yardstick] :
+         std::vector<std::pair<std::string, std::string>>{{"octree-design", "octree"}, {"bsp-design", "bsp"}})
+        expect_same_tree(build_hierarchy(balls, designed, set)->model_tree(), build_hierarchy(balls, yardstick)->model_tree(),
+                         designed);
+}
+
 TEST(Design, DesignReportsEachFamilyOnDisjointRays) {
     const Scene s = builtin_scene("balls", 2);
     DesignOptions o;

@@ -11,6 +11,7 @@
 #include "../bvh/topdown.hpp"
 #include "occlusion_order.hpp"
 #include "rtcost/design.hpp"
+#include "design/cheaper.hpp"
 
 namespace rtcost::bvh {
 namespace {
@@ -241,8 +242,18 @@ const Registration reg{
          o.trust = p.real("trust", 0, 1e30);
          const DesignInput in = draw_design_input(s, p);
          Designed d = build_design(s, in, o);
+         // bvh-sah's tree (front-to-back order) where the model predicts it cheaper on the sample
+         // than the designed splits (replayed front to back): design/cheaper.hpp.
+         SahOptions usual;
+         usual.max_depth = o.max_depth;
+         usual.bins = o.bins;
+         auto designed = std::make_unique<Bvh>(s, "bvh-design", d.data, true);
+         auto by_sah = std::make_unique<Bvh>(s, "bvh-design", build_sah(s, usual), true);
          if (p.choice("occlusion", {"near", "sample"}) == "near")
-             return std::make_unique<Bvh>(s, "bvh-design", std::move(d.data), true);
+             return designing::cheaper_on_sample(std::move(designed), std::move(by_sah), s, in);
+         if (sample_cost(by_sah->model_tree(), s, in.sample, in.costs) <
+             sample_cost(designed->model_tree(), s, in.sample, in.costs))
+             return by_sah;
          return std::make_unique<DesignedBvh>(s, std::move(d.data), std::move(d.right_first));
      }}};
 

@@ -2,9 +2,11 @@
 // model, with visit probabilities from the design sample (the share of the node's sample
 // segments, clipped where each ray's search ends, that meet each child cell, blended with the
 // surface-area ratio where few reach the node), says splitting it does not pay: Subramanian and
-// Fussell's automatic termination with the user's rays instead of isotropic lines.
+// Fussell's automatic termination with the user's rays instead of isotropic lines. Where the
+// model predicts kd-sah's own termination cheaper on the sample, that tree (design/cheaper.hpp).
 #include "../kd/kdtree.hpp"
 #include "design/cell_rays.hpp"
+#include "design/cheaper.hpp"
 
 namespace rtcost::kd {
 namespace {
@@ -50,7 +52,12 @@ const Registration reg{
          const Chooser choose = [&d](const std::vector<BuildRef>& refs, const Box3& cell, int) {
              return d.choose(refs, cell);
          };
-         return std::make_unique<KdTree>(s, "kd-design", build_tree(s, d.sah.build, choose), p.flag("mailbox"));
+         auto designed = std::make_unique<KdTree>(s, "kd-design", build_tree(s, d.sah.build, choose), p.flag("mailbox"));
+         SahOptions usual;  // kd-sah's defaults, with this tree's depth and assignment
+         usual.build = d.sah.build;
+         usual.build.max_prims = 1;
+         auto by_sah = std::make_unique<KdTree>(s, "kd-design", build_sah(s, usual), p.flag("mailbox"));
+         return designing::cheaper_on_sample(std::move(designed), std::move(by_sah), s, in);
      },
      kLargeScene}};  // kd-sah's O(N log^2 N) planes, each judged on the sample: 19 s for a million triangles
 

@@ -1,10 +1,12 @@
 // `octree-design`, `bsp-design`: Glassner's octree and Kaplan's BSP tree built by their own
 // builders, a cell split only where the cost model, with visit probabilities from a sample of
 // the given rays, says the split pays (design/cell_rays.hpp) -- instead of splitting down to
-// max_prims or max_depth.
+// max_prims or max_depth -- or, where the model predicts it cheaper on the sample, the tree the
+// builder makes with the yardstick's termination (design/cheaper.hpp).
 #include "../bsp/bsp.hpp"
 #include "../octree/octree.hpp"
 #include "design/cell_rays.hpp"
+#include "design/cheaper.hpp"
 
 namespace rtcost {
 namespace {
@@ -16,17 +18,23 @@ std::vector<ParamSpec> specs(int default_depth, int max_depth, int default_prims
     return p;
 }
 
-// Builds with the model's split test; the test (and the sample it reads) lives only during the build.
+// Builds with the model's split test (the test and the sample it reads live only during the
+// build) and with the yardstick's depth and leaf size (`usual_depth`, `usual_prims`), and keeps
+// the one the model predicts cheaper on the sample.
 template <class H, class O>
-std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, int max_depth, double planes, const char* name) {
+std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, int max_depth, double planes, const char* name,
+                                 int usual_depth, int usual_prims) {
     const DesignInput in = draw_design_input(s, p);
     designing::CellRays cells(s, in, p.real("trust", 0, 1e30), planes * in.costs.plane);
     O o = subdiv::read_options<O>(p, max_depth);
     o.name = name;
+    O usual = o;
+    usual.max_depth = usual_depth;
+    usual.max_prims = usual_prims;
     o.split_pays = [&cells](const Box3& cell, std::size_t n, const Box3* children, const std::size_t* counts, int k) {
         return cells.split_pays(cell, n, children, counts, k);
     };
-    return std::make_unique<H>(s, o);
+    return designing::cheaper_on_sample(std::make_unique<H>(s, o), std::make_unique<H>(s, usual), s, in);
 }
 
 // The operations of one interior visit: an octree node's three planes, a BSP node's one.
@@ -34,14 +42,16 @@ const Registration octree_reg{
     {"octree-design", "Glassner's octree, a cell split only where the cost model with a sample of the given rays says it pays",
      specs(12, octree::kMaxDepth, 1),
      [](const Scene& s, const Params& p) {
-         return build<octree::Octree, octree::Options>(s, p, octree::kMaxDepth, 3, "octree-design");
+         return build<octree::Octree, octree::Options>(s, p, octree::kMaxDepth, 3, "octree-design", 8, 1);
      },
      kLargeScene}};  // every candidate split replayed on the sample: 10 s for a million triangles
 
 const Registration bsp_reg{
     {"bsp-design", "Kaplan's BSP tree, a cell split only where the cost model with a sample of the given rays says it pays",
      specs(30, bsp::kMaxDepth, 1),
-     [](const Scene& s, const Params& p) { return build<bsp::Bsp, bsp::Options>(s, p, bsp::kMaxDepth, 1, "bsp-design"); }}};
+     [](const Scene& s, const Params& p) {
+         return build<bsp::Bsp, bsp::Options>(s, p, bsp::kMaxDepth, 1, "bsp-design", 20, 2);
+     }}};
 
 }  // namespace
 }  // namespace rtcost
