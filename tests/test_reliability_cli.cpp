@@ -119,6 +119,14 @@ TEST(ReliabilityCli, PlyAndOffCountsAndIndicesAreChecked) {
                      "refers to vertex '3'");
     EXPECT_BAD_INPUT(rtcost("info " + file("count.off", "OFF\n4 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()),
                      "declares 1 faces");
+    // The mesh fuzzer's finding: "OFF" with its counts glued on ("OFF111777777770 0111...") was
+    // not taken for OFF by the check, and assimp then tried to allocate 53 GB for the vertices.
+    EXPECT_BAD_INPUT(rtcost("info " + file("glued.off", "OFF111777777770 01111 0\n0 0 0\n").string()),
+                     "declares 111777777770 vertices");
+    EXPECT_EQ(rtcost("info -q " + file("glued-ok.off", "OFF3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()).code, 0);
+    // Two counts: assimp would read the next line as the third.
+    EXPECT_BAD_INPUT(rtcost("info " + file("two.off", "OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()),
+                     "needs three numbers");
 }
 
 TEST(ReliabilityCli, FormerHangsEnd) {

@@ -228,9 +228,12 @@ void check_off(const std::string& path, const std::string& bytes) {
     std::string_view head = lines[0].first;
     std::size_t at = 1;
     if (head.find("BINARY") != std::string_view::npos) return;  // binary OFF: left to assimp
-    auto kw = head.substr(0, std::min(head.find_first_of(" \t"), head.size()));
-    if (kw.size() < 3 || kw.substr(kw.size() - 3) != "OFF") return;  // not the OFF we know
-    std::string_view counts = head.substr(kw.size());
+    // The keyword: [ST][C][N][4][n]OFF. What follows it on the line, with or without a space,
+    // is the counts: assimp reads "OFF12 3" as OFF with counts, so rtcost checks them too.
+    const std::size_t off = head.find("OFF");
+    if (off == std::string_view::npos || head.substr(0, off).find_first_not_of("STCN4n") != std::string_view::npos)
+        return;  // not the OFF we know
+    std::string_view counts = head.substr(off + 3);
     while (!counts.empty() && is_space(counts.front())) counts.remove_prefix(1);
     if (counts.empty()) {
         if (at >= lines.size()) fail(lines[0].second, "no vertex and face counts");
@@ -240,6 +243,9 @@ void check_off(const std::string& path, const std::string& bytes) {
     long long nv = 0, nf = 0;
     if (!to_int(cw.next(), nv) || !to_int(cw.next(), nf) || nv < 0 || nf < 0)
         fail(lines[at - 1].second, "bad vertex and face counts");
+    // The edge count is unused but required: without it assimp reads the next line as counts.
+    if (long long ne = 0; !to_int(cw.next(), ne) || ne < 0)
+        fail(lines[at - 1].second, "the counts line needs three numbers: vertices, faces and edges");
     if (static_cast<long long>(lines.size() - at) < nv)
         fail(0, fmt::format("declares {} vertices, the file has {} lines after the counts", nv, lines.size() - at));
     at += static_cast<std::size_t>(nv);
