@@ -124,6 +124,12 @@ TEST(ReliabilityCli, PlyAndOffCountsAndIndicesAreChecked) {
     EXPECT_BAD_INPUT(rtcost("info " + file("glued.off", "OFF111777777770 01111 0\n0 0 0\n").string()),
                      "declares 111777777770 vertices");
     EXPECT_EQ(rtcost("info -q " + file("glued-ok.off", "OFF3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()).code, 0);
+    // Its second finding: assimp takes the keyword as optional, so a first line of counts is OFF
+    // too (here 77770 vertices and an overflowing face count: a 45 GB allocation).
+    EXPECT_EQ(rtcost("info -q " + file("bare.off", "3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()).code, 0);
+    EXPECT_BAD_INPUT(rtcost("info " + file("bare-huge.off", "77770 0111111111111111111111111r11 0\n1 1\n").string()),
+                     "bad vertex and face counts");
+    EXPECT_BAD_INPUT(rtcost("info " + file("neither.off", "hello\n3 1 0\n").string()), "neither an OFF keyword");
     // Two counts: assimp would read the next line as the third.
     EXPECT_BAD_INPUT(rtcost("info " + file("two.off", "OFF\n3 1\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()),
                      "needs three numbers");

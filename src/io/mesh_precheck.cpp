@@ -230,10 +230,13 @@ void check_off(const std::string& path, const std::string& bytes) {
     if (head.find("BINARY") != std::string_view::npos) return;  // binary OFF: left to assimp
     // The keyword: [ST][C][N][4][n]OFF. What follows it on the line, with or without a space,
     // is the counts: assimp reads "OFF12 3" as OFF with counts, so rtcost checks them too.
+    // Assimp takes the keyword as optional: without it, the first line is the counts.
     const std::size_t off = head.find("OFF");
-    if (off == std::string_view::npos || head.substr(0, off).find_first_not_of("STCN4n") != std::string_view::npos)
-        return;  // not the OFF we know
-    std::string_view counts = head.substr(off + 3);
+    std::string_view counts = head;
+    if (off != std::string_view::npos && head.substr(0, off).find_first_not_of("STCN4n") == std::string_view::npos)
+        counts = head.substr(off + 3);
+    else if (head.find_first_not_of("0123456789") == 0)
+        fail(lines[0].second, "the first line is neither an OFF keyword nor the vertex, face and edge counts");
     while (!counts.empty() && is_space(counts.front())) counts.remove_prefix(1);
     if (counts.empty()) {
         if (at >= lines.size()) fail(lines[0].second, "no vertex and face counts");
