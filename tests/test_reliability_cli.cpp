@@ -124,6 +124,12 @@ TEST(ReliabilityCli, PlyAndOffCountsAndIndicesAreChecked) {
     EXPECT_BAD_INPUT(rtcost("info " + file("glued.off", "OFF111777777770 01111 0\n0 0 0\n").string()),
                      "declares 111777777770 vertices");
     EXPECT_EQ(rtcost("info -q " + file("glued-ok.off", "OFF3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()).code, 0);
+    // Its third: assimp reads "Ply" as PLY (the check only knew "ply") and spun on a header
+    // without end_header. Now any .ply goes through the check.
+    EXPECT_BAD_INPUT(rtcost("info " + file("caps.ply", "Ply\nformat ascii 1.0\nelement vertex 2\nend_head0\n3 0 1 2\n").string()),
+                     "no 'end_header' line");
+    EXPECT_EQ(rtcost("info -q " + file("caps-ok.ply", "Ply" + ply(3, verts + "3 0 1 2\n").substr(3)).string()).code, 0);
+    EXPECT_BAD_INPUT(rtcost("info " + file("nomagic.ply", "hello\n").string()), "does not begin with 'ply'");
     // Its second finding: assimp takes the keyword as optional, so a first line of counts is OFF
     // too (here 77770 vertices and an overflowing face count: a 45 GB allocation).
     EXPECT_EQ(rtcost("info -q " + file("bare.off", "3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()).code, 0);

@@ -116,8 +116,8 @@ void check_ply(const std::string& path, const std::string& bytes) {
     Words w(std::string_view(bytes).substr(0, end), 0, 1);
     for (std::string_view t = w.next(); !t.empty(); t = w.next()) {
         const int line = w.line();
-        if (t == "comment" || t == "obj_info" || t == "ply") {
-            if (t != "ply") w.skip_line();
+        if (t == "comment" || t == "obj_info" || w.line() == 1) {
+            if (t == "comment" || t == "obj_info") w.skip_line();  // line 1: the magic, 'ply' in any case
         } else if (t == "format") {
             format = std::string(w.next());
             w.skip_line();
@@ -276,7 +276,11 @@ void precheck_mesh(const std::string& path) {
     if (ext != ".ply" && ext != ".off") return;
     const std::string bytes = read_whole(path);
     if (ext == ".ply") {
-        if (bytes.size() >= 3 && bytes.compare(0, 3, "ply") == 0) check_ply(path, bytes);
+        // Assimp reads any .ply as PLY and takes the magic in any case ("Ply"): so must the check.
+        auto lower = [](char c) { return static_cast<char>(c >= 'A' && c <= 'Z' ? c - 'A' + 'a' : c); };
+        if (bytes.size() < 3 || lower(bytes[0]) != 'p' || lower(bytes[1]) != 'l' || lower(bytes[2]) != 'y')
+            throw InputError(path, 1, "PLY: the file does not begin with 'ply'");
+        check_ply(path, bytes);
     } else {
         check_off(path, bytes);
     }
