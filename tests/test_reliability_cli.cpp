@@ -130,6 +130,10 @@ TEST(ReliabilityCli, PlyAndOffCountsAndIndicesAreChecked) {
                      "no 'end_header' line");
     EXPECT_EQ(rtcost("info -q " + file("caps-ok.ply", "Ply" + ply(3, verts + "3 0 1 2\n").substr(3)).string()).code, 0);
     EXPECT_BAD_INPUT(rtcost("info " + file("nomagic.ply", "hello\n").string()), "does not begin with 'ply'");
+    // Its fourth: "BINARY" anywhere on the first line let the file through to assimp unchecked.
+    EXPECT_BAD_INPUT(rtcost("info " + file("bin-glued.off", "OFF111777777770 0111BINARY11 0\n").string()),
+                     "bad vertex and face counts");
+    EXPECT_BAD_INPUT(rtcost("info " + file("bin.off", "OFF BINARY\n").string()), "binary OFF is not supported");
     // Its second finding: assimp takes the keyword as optional, so a first line of counts is OFF
     // too (here 77770 vertices and an overflowing face count: a 45 GB allocation).
     EXPECT_EQ(rtcost("info -q " + file("bare.off", "3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n").string()).code, 0);

@@ -227,7 +227,6 @@ void check_off(const std::string& path, const std::string& bytes) {
     if (lines.empty()) fail(0, "empty file");
     std::string_view head = lines[0].first;
     std::size_t at = 1;
-    if (head.find("BINARY") != std::string_view::npos) return;  // binary OFF: left to assimp
     // The keyword: [ST][C][N][4][n]OFF. What follows it on the line, with or without a space,
     // is the counts: assimp reads "OFF12 3" as OFF with counts, so rtcost checks them too.
     // Assimp takes the keyword as optional: without it, the first line is the counts.
@@ -238,6 +237,8 @@ void check_off(const std::string& path, const std::string& bytes) {
     else if (head.find_first_not_of("0123456789") == 0)
         fail(lines[0].second, "the first line is neither an OFF keyword nor the vertex, face and edge counts");
     while (!counts.empty() && is_space(counts.front())) counts.remove_prefix(1);
+    // Assimp reads text OFF only (a binary one fails with "no valid vertices", or worse).
+    if (counts.substr(0, 6) == "BINARY") fail(lines[0].second, "binary OFF is not supported; write it as text");
     if (counts.empty()) {
         if (at >= lines.size()) fail(lines[0].second, "no vertex and face counts");
         counts = lines[at++].first;
