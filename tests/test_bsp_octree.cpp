@@ -482,13 +482,6 @@ TEST(BspOctreeHits, AnyHitAndAllHitsAgreeWithBruteForce) {
 
 // --- counters --------------------------------------------------------------------------------
 
-RayCounters count_one(const Hierarchy& h, const Ray& r, Hit& hit) {
-    RayCounters c;
-    hit = Hit{};
-    h.closest(r, hit, c);
-    return c;
-}
-
 TEST(BspCounters, LocateDescendsFromTheRootForEveryCell) {
     Scene s = abc_scene();
     auto loc = build_hierarchy(s, "bsp", {"max_prims=1"});

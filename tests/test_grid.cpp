@@ -515,12 +515,6 @@ Scene row_scene(bool with_triangle) {
     return s;
 }
 
-RayCounters count_one(const Hierarchy& h, const Ray& r, Hit& hit) {
-    RayCounters c;
-    h.closest(r, hit, c);
-    return c;
-}
-
 TEST(GridCounters, AxisParallelRayHopsCellsMinusOne) {
     Scene s = row_scene(false);
     auto h = build_hierarchy(s, "grid", {"res=8x1x1"});

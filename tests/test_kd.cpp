@@ -401,12 +401,6 @@ TEST(KdHits, EmptySceneCostsOneBoxTest) {
 
 // --- counters --------------------------------------------------------------------------------
 
-RayCounters count_one(const Hierarchy& h, const Ray& r, Hit& hit) {
-    RayCounters c;
-    h.closest(r, hit, c);
-    return c;
-}
-
 TEST(KdCounters, WalkThroughTheMedianRow) {
     // The four-triangle row of MedianCutOnFourTrianglesInARow. Triangle k lies in the plane
     // x - x0 = y - z; a ray along x at y = 0.999, z = 0.001 hits each at x = x0 + 0.998.
