@@ -56,9 +56,22 @@ struct ModelNode {
     float beam_u[2] = {-1, 1}, beam_v[2] = {-1, 1};
 };
 
+/// A hierarchy's family, as the model tree declares it: the `paper` preset charges each
+/// family's nodes by the seed paper's formula for it.
+enum class ModelFamily : std::uint8_t {
+    Bvh,     ///< bounding volume hierarchies (and brute force, a one-leaf BVH)
+    Bsp,     ///< Kaplan's BSP tree
+    Octree,  ///< Glassner's octree
+    Kd,      ///< kd-trees
+    Grid,    ///< uniform grids
+    Rc5d,    ///< Arvo and Kirk's 5D ray classification
+};
+
 /// The flags of a model tree: what the nodes alone do not say about the traversal.
 struct ModelFlags {
-    std::string family;                ///< "bvh", "bsp", "octree", "kd", "grid", "rc5d"
+    /// Every hierarchy names its family: there is no default to fall back on.
+    explicit ModelFlags(ModelFamily f) : family(f) {}
+    ModelFamily family;
     /// Leaves are found by descending from the root for every cell (Kaplan's and Glassner's
     /// `locate` traversal): each leaf visit pays the operations of all its ancestors again.
     bool locate = false;
@@ -81,6 +94,8 @@ struct ModelFlags {
 /// contiguous. Binary for space subdivisions; a BVH node may have more than two children
 /// (Goldsmith and Salmon's trees are n-ary), each entered through its own box test.
 struct ModelTree : ModelFlags {
+    /// An empty tree (a hierarchy the model cannot see into); emit_model's flags replace these.
+    ModelTree() : ModelFlags(ModelFamily::Bvh) {}
     std::vector<ModelNode> nodes;
     std::vector<std::uint32_t> prims;  ///< leaf primitive references
 };
