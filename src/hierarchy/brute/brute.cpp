@@ -1,6 +1,6 @@
 // `brute`: tests every primitive for every ray. The reference every other hierarchy is checked
 // against; it has no structure, so its structural statistics describe one leaf holding all.
-#include "rtcost/hierarchy.hpp"
+#include "../common/impl.hpp"
 
 namespace rtcost {
 namespace {
