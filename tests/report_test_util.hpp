@@ -1,17 +1,16 @@
 #pragma once
-// Helpers of the heat map and report tests: PNG decoding, running the CLI, files.
+// Helpers of the heat map and report tests: PNG decoding and a temporary directory (files and
+// the CLI come from test_support.hpp).
 #include <png.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <array>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 #include <string>
 
 #include "rtcost/whitted.hpp"
+#include "test_support.hpp"
 
 namespace rtcost::report_test {
 
@@ -42,24 +41,8 @@ inline fs::path temp_dir() {
     return d;
 }
 
-inline std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-struct CliRun {
-    int code;
-    std::string out, err;
-};
-
-inline CliRun run_cli(const std::string& args) {
-    fs::path d = temp_dir();
-    std::string cmd = std::string(RTCOST_CLI) + " " + args + " > " + (d / "out").string() + " 2> " +
-                      (d / "err").string() + " < /dev/null";
-    int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(d / "out"), slurp(d / "err")};
-}
+using test::CliRun;
+using test::run_cli;
+using test::slurp;
 
 }  // namespace rtcost::report_test

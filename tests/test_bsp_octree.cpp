@@ -68,7 +68,7 @@ TEST(BspStructure, ModelTreeMirrorsTheNodes) {
     for (const char* trav : {"traversal=locate", "traversal=recursive"}) {
         auto h = build_hierarchy(s, "bsp", {"max_prims=1", trav});
         ModelTree t = h->model_tree();
-        EXPECT_EQ(t.family, "bsp");
+        EXPECT_EQ(t.family, ModelFamily::Bsp);
         EXPECT_EQ(t.locate, std::string(trav) == "traversal=locate");
         ASSERT_EQ(t.nodes.size(), 9u);
         EXPECT_EQ(t.nodes[0].region.hi, (Vec3{16, 16, 16}));
@@ -113,7 +113,7 @@ TEST(OctreeStructure, ExactCountsOnThreeSpheres) {
 TEST(OctreeStructure, ModelTreeIsThreeBinaryLevelsPerNode) {
     Scene s = abc_scene();
     ModelTree t = build_hierarchy(s, "octree")->model_tree();
-    EXPECT_EQ(t.family, "octree");
+    EXPECT_EQ(t.family, ModelFamily::Octree);
     EXPECT_TRUE(t.locate);
     // Two octree interior nodes: 2 x (1 + 2 + 4) binary nodes, and 15 leaves.
     ASSERT_EQ(t.nodes.size(), 14u + 15u);
@@ -481,13 +481,6 @@ TEST(BspOctreeHits, AnyHitAndAllHitsAgreeWithBruteForce) {
 }
 
 // --- counters --------------------------------------------------------------------------------
-
-RayCounters count_one(const Hierarchy& h, const Ray& r, Hit& hit) {
-    RayCounters c;
-    hit = Hit{};
-    h.closest(r, hit, c);
-    return c;
-}
 
 TEST(BspCounters, LocateDescendsFromTheRootForEveryCell) {
     Scene s = abc_scene();

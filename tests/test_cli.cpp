@@ -7,40 +7,24 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-#include <sys/wait.h>
+#include <unistd.h>
 
 #include "rtcost/io.hpp"
 #include "rtcost/rays.hpp"
+#include "test_support.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct CliRun {
-    int code;
-    std::string out, err;
-};
+using rtcost::test::CliRun;
+using rtcost::test::run_cli;
+using rtcost::test::slurp;
 
 fs::path temp_dir() {
     fs::path d = fs::temp_directory_path() / ("rtcost_cli_" + std::to_string(::getpid()));
     fs::create_directories(d);
     return d;
-}
-
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-CliRun run(const std::string& args) {
-    fs::path d = temp_dir();
-    std::string cmd = std::string(RTCOST_CLI) + " " + args + " > " + (d / "out").string() + " 2> " + (d / "err").string() +
-                      " < /dev/null";
-    int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(d / "out"), slurp(d / "err")};
 }
 
 fs::path write(const std::string& name, const std::string& bytes) {
@@ -54,34 +38,34 @@ const char* kSmallNff =
     "l 0 5 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\np 3\n-3 -3 -2\n3 -3 -2\n0 3 -2\n";
 
 TEST(Cli, HelpListsSubcommandsAndHierarchyParameters) {
-    CliRun r = run("--help");
+    CliRun r = run_cli("--help");
     EXPECT_EQ(r.code, 0);
     for (const char* s : {"info", "build", "trace", "list"}) EXPECT_NE(r.out.find(s), std::string::npos) << s;
-    CliRun t = run("trace --help");
+    CliRun t = run_cli("trace --help");
     EXPECT_EQ(t.code, 0);
     EXPECT_NE(t.out.find("bvh-sah"), std::string::npos);
     EXPECT_NE(t.out.find("rtcost list"), std::string::npos);  // where the parameters are
     EXPECT_EQ(t.out.find("max_prims=8"), std::string::npos);  // not repeated in every --help
     EXPECT_NE(t.out.find("--threads"), std::string::npos);
-    CliRun l = run("list");
+    CliRun l = run_cli("list");
     EXPECT_EQ(l.code, 0);
     EXPECT_NE(l.out.find("max_prims=8"), std::string::npos);  // defaults are printed
-    CliRun lj = run("list --json");
+    CliRun lj = run_cli("list --json");
     ASSERT_EQ(lj.code, 0);
     auto j = nlohmann::json::parse(lj.out);
     EXPECT_GE(j["hierarchies"].size(), 10u);
     EXPECT_EQ(j["builtin_scenes"][0]["name"], "builtin:balls");
     EXPECT_EQ(j["builtin_scenes"][0]["levels"]["default"], 4);
-    CliRun v = run("--version");
+    CliRun v = run_cli("--version");
     EXPECT_EQ(v.code, 0);
     EXPECT_EQ(v.out.rfind("rtcost ", 0), 0u) << v.out;
-    CliRun bad = run("trace builtin:balls --no-such-option");
+    CliRun bad = run_cli("trace builtin:balls --no-such-option");
     EXPECT_EQ(bad.code, 2);
     EXPECT_EQ(bad.err.rfind("rtcost: error: ", 0), 0u) << bad.err;
 }
 
 TEST(Cli, InfoJsonReportsCountsBoundsLightsCamera) {
-    CliRun r = run("info builtin:balls --json");
+    CliRun r = run_cli("info builtin:balls --json");
     ASSERT_EQ(r.code, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["primitives"], 7382);
@@ -94,7 +78,7 @@ TEST(Cli, InfoJsonReportsCountsBoundsLightsCamera) {
 
 TEST(Cli, TraceJsonHasTimingsAndPerRayCounters) {
     fs::path scene = write("small.nff", kSmallNff);
-    CliRun r = run("trace " + scene.string() + " --hierarchy bvh-sah --rays camera --json --threads 1");
+    CliRun r = run_cli("trace " + scene.string() + " --hierarchy bvh-sah --rays camera --json --threads 1");
     ASSERT_EQ(r.code, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["hierarchy"], "bvh-sah");
@@ -124,7 +108,7 @@ TEST(Cli, TraceWritesHitsMatchingBruteForce) {
     fs::path rf = temp_dir() / "four.rays";
     rtcost::write_rays(rf.string(), rays);
     fs::path hf = temp_dir() / "four.hits";
-    CliRun r = run("trace " + scene.string() + " -H brute --rays " + rf.string() + " --hits " + hf.string() + " -q");
+    CliRun r = run_cli("trace " + scene.string() + " -H brute --rays " + rf.string() + " --hits " + hf.string() + " -q");
     ASSERT_EQ(r.code, 0) << r.err;
     auto hits = rtcost::read_hits(hf.string());
     ASSERT_EQ(hits.size(), 4u);
@@ -136,7 +120,7 @@ TEST(Cli, TraceWritesHitsMatchingBruteForce) {
     EXPECT_EQ(hits[3].prim, -1);
     // Same file through a BVH: byte-identical hits.
     fs::path hf2 = temp_dir() / "four_bvh.hits";
-    ASSERT_EQ(run("trace " + scene.string() + " -H bvh-median --rays " + rf.string() + " --hits " + hf2.string()).code, 0);
+    ASSERT_EQ(run_cli("trace " + scene.string() + " -H bvh-median --rays " + rf.string() + " --hits " + hf2.string()).code, 0);
     EXPECT_EQ(slurp(hf), slurp(hf2));
 }
 
@@ -144,7 +128,7 @@ TEST(Cli, RayFileOfWrongSizeIsRejectedAndNoHitsFileWritten) {
     fs::path rf = write("bad.rays", std::string(33, '\0'));
     fs::path hf = temp_dir() / "never.hits";
     fs::remove(hf);
-    CliRun r = run("trace builtin:tetra:2 --rays " + rf.string() + " --hits " + hf.string());
+    CliRun r = run_cli("trace builtin:tetra:2 --rays " + rf.string() + " --hits " + hf.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find(rf.string()), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("not a multiple of 32"), std::string::npos) << r.err;
@@ -156,14 +140,14 @@ TEST(Cli, RayFileWithNaNNamesTheRay) {
     rays[2].o.y = std::nanf("");
     fs::path rf = temp_dir() / "nan.rays";
     rtcost::write_rays(rf.string(), rays);
-    CliRun r = run("trace builtin:tetra:2 --rays " + rf.string());
+    CliRun r = run_cli("trace builtin:tetra:2 --rays " + rf.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("ray 2"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("not finite"), std::string::npos) << r.err;
 }
 
 TEST(Cli, MissingSceneFileIsAClearError) {
-    CliRun r = run("info /no/such/scene.nff");
+    CliRun r = run_cli("info /no/such/scene.nff");
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("/no/such/scene.nff"), std::string::npos) << r.err;
     EXPECT_NE(r.err.find("no such file"), std::string::npos) << r.err;
@@ -171,52 +155,52 @@ TEST(Cli, MissingSceneFileIsAClearError) {
 
 TEST(Cli, MalformedNffNamesFileAndLine) {
     fs::path scene = write("broken.nff", "s 0 0 0 1\ns 1 2 nan 1\n");
-    CliRun r = run("info " + scene.string());
+    CliRun r = run_cli("info " + scene.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find(scene.string() + ":2:"), std::string::npos) << r.err;
     fs::path trunc = write("trunc.nff", "p 4\n0 0 0\n1 0 0\n");
-    CliRun t = run("info " + trunc.string());
+    CliRun t = run_cli("info " + trunc.string());
     EXPECT_EQ(t.code, 2);
     EXPECT_NE(t.err.find(trunc.string()), std::string::npos) << t.err;
 }
 
 TEST(Cli, EmptySceneIsAClearError) {
     fs::path scene = write("empty.nff", "# nothing here\nb 0 0 0\n");
-    CliRun r = run("info " + scene.string());
+    CliRun r = run_cli("info " + scene.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("no primitives"), std::string::npos) << r.err;
 }
 
 TEST(Cli, UnknownOptionsHierarchiesAndParametersExitTwo) {
-    CliRun a = run("trace builtin:tetra:2 --frobnicate");
+    CliRun a = run_cli("trace builtin:tetra:2 --frobnicate");
     EXPECT_EQ(a.code, 2);
     EXPECT_NE(a.err.find("frobnicate"), std::string::npos) << a.err;
-    CliRun b = run("trace builtin:tetra:2 --hierarchy nope");
+    CliRun b = run_cli("trace builtin:tetra:2 --hierarchy nope");
     EXPECT_EQ(b.code, 2);
     EXPECT_NE(b.err.find("unknown hierarchy 'nope'"), std::string::npos) << b.err;
-    CliRun c = run("build builtin:tetra:2 --hierarchy bvh-sah --set max_prims=-4");
+    CliRun c = run_cli("build builtin:tetra:2 --hierarchy bvh-sah --set max_prims=-4");
     EXPECT_EQ(c.code, 2);
     EXPECT_NE(c.err.find("max_prims"), std::string::npos) << c.err;
-    CliRun d = run("frobnicate");
+    CliRun d = run_cli("frobnicate");
     EXPECT_EQ(d.code, 2);
-    CliRun e = run("info builtin:nosuchscene");
+    CliRun e = run_cli("info builtin:nosuchscene");
     EXPECT_EQ(e.code, 2);
     EXPECT_NE(e.err.find("nosuchscene"), std::string::npos) << e.err;
 }
 
 TEST(Cli, DegeneratePrimitivesAreReportedAndSkipped) {
     fs::path scene = write("degen.nff", "s 0 0 0 0\ns 0 0 0 1\np 3\n0 0 0\n1 1 1\n2 2 2\n");
-    CliRun r = run("info " + scene.string() + " --json");
+    CliRun r = run_cli("info " + scene.string() + " --json");
     ASSERT_EQ(r.code, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["primitives"], 1);
     EXPECT_EQ(j["warnings"], 2);
-    CliRun t = run("info " + scene.string());
+    CliRun t = run_cli("info " + scene.string());
     EXPECT_NE(t.err.find(scene.string() + ":1:"), std::string::npos) << t.err;
 }
 
 TEST(Cli, BuildPrintsStructure) {
-    CliRun r = run("build builtin:tetra:3 -H bvh-median --set max_prims=1 --json");
+    CliRun r = run_cli("build builtin:tetra:3 -H bvh-median --set max_prims=1 --json");
     ASSERT_EQ(r.code, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["build"]["N_V"], 64);
@@ -227,7 +211,7 @@ TEST(Cli, BuildPrintsStructure) {
 }
 
 TEST(Cli, QuietAndPipedOutputHasNoProgressNoise) {
-    CliRun r = run("trace builtin:tetra:3 -H bvh-sah --rays camera --size 32x32");
+    CliRun r = run_cli("trace builtin:tetra:3 -H bvh-sah --rays camera --size 32x32");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_EQ(r.err, "");  // stderr is not a terminal here: no progress drawn
     EXPECT_NE(r.out.find("1024"), std::string::npos);
@@ -239,7 +223,7 @@ namespace {
 
 TEST(CliModel, CalibrateWritesCostsThatEvalReadsForTime) {
     fs::path costs = temp_dir() / "costs.json";
-    CliRun c = run("calibrate builtin:balls:2 builtin:tetra:3 builtin:tetra:4 -H brute,bvh-sah,bvh-median,grid,rc5d "
+    CliRun c = run_cli("calibrate builtin:balls:2 builtin:tetra:3 builtin:tetra:4 -H brute,bvh-sah,bvh-median,grid,rc5d "
                    "--size 32x32 --repeat 1 -q --json -o " + costs.string());
     ASSERT_EQ(c.code, 0) << c.err;
     auto j = nlohmann::json::parse(c.out);
@@ -250,7 +234,7 @@ TEST(CliModel, CalibrateWritesCostsThatEvalReadsForTime) {
     EXPECT_GE(j["ns_per_operation"]["box"].get<double>(), 0.0);
     EXPECT_GT(j["ns_per_operation"]["triangle"].get<double>() + j["ns_per_operation"]["sphere"].get<double>(), 0.0);
     ASSERT_TRUE(fs::exists(costs));
-    CliRun e = run("eval builtin:balls:2 -H bvh-sah,grid --size 32x32 --costs " + costs.string() + " -q --json");
+    CliRun e = run_cli("eval builtin:balls:2 -H bvh-sah,grid --size 32x32 --costs " + costs.string() + " -q --json");
     ASSERT_EQ(e.code, 0) << e.err;
     auto ej = nlohmann::json::parse(e.out);
     EXPECT_EQ(ej["unit_costs"], "ns");
@@ -264,14 +248,14 @@ TEST(CliModel, CalibrateWritesCostsThatEvalReadsForTime) {
 TEST(CliModel, CalibrateWithTooFewRunsIsAClearError) {
     fs::path costs = temp_dir() / "few.json";
     fs::remove(costs);
-    CliRun c = run("calibrate builtin:balls:2 -H bvh-sah --size 16x16 --repeat 1 -q -o " + costs.string());
+    CliRun c = run_cli("calibrate builtin:balls:2 -H bvh-sah --size 16x16 --repeat 1 -q -o " + costs.string());
     EXPECT_EQ(c.code, 2);
     EXPECT_NE(c.err.find("need at least"), std::string::npos) << c.err;
     EXPECT_FALSE(fs::exists(costs));
 }
 
 TEST(CliModel, EvalAllHierarchiesJsonHasPredictedMeasuredAndRanks) {
-    CliRun e = run("eval builtin:tetra:4 --rays lines --count 4000 --query all -q --json");
+    CliRun e = run_cli("eval builtin:tetra:4 --rays lines --count 4000 --query all -q --json");
     ASSERT_EQ(e.code, 0) << e.err;
     auto j = nlohmann::json::parse(e.out);
     ASSERT_GE(j["results"].size(), 6u);

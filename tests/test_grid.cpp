@@ -292,7 +292,7 @@ TEST(GridStructure, ModelTreeIsTheBalancedSplitOfTheCells) {
     auto h = build_hierarchy(s, "grid", {"res=4x2x1"});
     const Grid& g = as_grid(*h);
     ModelTree t = h->model_tree();
-    EXPECT_EQ(t.family, "grid");
+    EXPECT_EQ(t.family, ModelFamily::Grid);
     EXPECT_EQ(t.per_ray_box, 1.0f);
     EXPECT_EQ(t.per_entry_hop, -1.0f);
     ASSERT_EQ(t.nodes.size(), 15u);  // 8 cells, 7 binary nodes
@@ -513,12 +513,6 @@ Scene row_scene(bool with_triangle) {
     if (with_triangle) s.add(Triangle{{0, 0.1f, 0}, {8, 0.1f, 0}, {8, 0.1f, 1}}, 0);
     s.finalize();
     return s;
-}
-
-RayCounters count_one(const Hierarchy& h, const Ray& r, Hit& hit) {
-    RayCounters c;
-    h.closest(r, hit, c);
-    return c;
 }
 
 TEST(GridCounters, AxisParallelRayHopsCellsMinusOne) {

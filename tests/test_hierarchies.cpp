@@ -128,13 +128,13 @@ TEST_P(SceneCheck, CountingDoesNotChangeHitsAndInvariantsHold) {
     for (const auto& [name, set] : kVariants) {
         auto h = build_hierarchy(r.scene, name, set);
         StructureStats s = h->structure();
-        const std::string family = h->model_tree().family;
-        if (family == "bvh") {
+        const ModelFamily family = h->model_tree().family;
+        if (family == ModelFamily::Bvh) {
             // Binary trees: N_V = N_IN + 1; n-ary ones (Goldsmith-Salmon): more leaves than that.
             if (name == "bvh-gs" || name == "bvh-wide") EXPECT_GE(s.leaves, s.interior + 1) << name;
             else EXPECT_EQ(s.leaves, s.interior + 1) << name;
             EXPECT_EQ(s.references, r.scene.size()) << name;  // every primitive in exactly one leaf
-        } else if (family == "grid") {
+        } else if (family == ModelFamily::Grid) {
             EXPECT_EQ(s.interior, 1u) << name;
             EXPECT_GE(s.references, r.scene.size()) << name;  // every primitive in at least one cell
         }
@@ -149,14 +149,14 @@ TEST_P(SceneCheck, CountingDoesNotChangeHitsAndInvariantsHold) {
         const RayCounters& c = counted.counters;
         EXPECT_EQ(c.rays, rays.size());
 
-        if (family == "bvh") {
+        if (family == ModelFamily::Bvh) {
             EXPECT_GT(c.box, c.rays);  // the root box per ray, and more for rays that enter
             EXPECT_EQ(c.plane + c.hop + c.classify, 0u);
-        } else if (family == "grid") {
+        } else if (family == ModelFamily::Grid) {
             EXPECT_EQ(c.box, c.rays);  // the clip to the grid box, nothing else
             EXPECT_GT(c.hop, 0u);
             EXPECT_EQ(c.plane + c.classify, 0u);
-        } else if (family == "rc5d") {
+        } else if (family == ModelFamily::Rc5d) {
             EXPECT_EQ(c.box, c.rays);
             EXPECT_GT(c.classify, c.rays / 2);
             EXPECT_EQ(c.plane + c.hop, 0u);

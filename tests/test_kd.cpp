@@ -42,7 +42,7 @@ TEST(KdStructure, MedianCutOnFourTrianglesInARow) {
     EXPECT_EQ(st.bytes, 7 * sizeof(kd::Node) + 4 * sizeof(std::uint32_t) + 7 * sizeof(Box3));
     ModelTree t = h->model_tree();
     ASSERT_EQ(t.nodes.size(), 7u);
-    EXPECT_EQ(t.family, "kd");
+    EXPECT_EQ(t.family, ModelFamily::Kd);
     const ModelNode& root = t.nodes[0];
     EXPECT_EQ(root.axis, 0);
     EXPECT_EQ(root.split, 3.5f);
@@ -400,12 +400,6 @@ TEST(KdHits, EmptySceneCostsOneBoxTest) {
 }
 
 // --- counters --------------------------------------------------------------------------------
-
-RayCounters count_one(const Hierarchy& h, const Ray& r, Hit& hit) {
-    RayCounters c;
-    h.closest(r, hit, c);
-    return c;
-}
 
 TEST(KdCounters, WalkThroughTheMedianRow) {
     // The four-triangle row of MedianCutOnFourTrianglesInARow. Triangle k lies in the plane

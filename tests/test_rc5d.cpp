@@ -109,7 +109,7 @@ TEST(Rc5dStructure, TwoSpheresExactBeams) {
     EXPECT_EQ(st.bytes, 2u * 24u + 2u * 6u * 4u + 18u * sizeof(rc5d::Node) + 14u * 4u);
 
     ModelTree t = eager->model_tree();
-    EXPECT_EQ(t.family, "rc5d");
+    EXPECT_EQ(t.family, ModelFamily::Rc5d);
     ASSERT_EQ(t.nodes.size(), 19u);  // root, 6 cubes, 12 beams
     EXPECT_EQ(t.nodes[0].count, 6u);
     EXPECT_EQ(t.nodes[0].classify, 3.0f);

@@ -2,24 +2,22 @@
 // for bad options and inputs, outputs onto devices, links and directories, the mesh checks that
 // assimp does not make, and hangs that must now end.
 #include <sys/stat.h>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
 #include <gtest/gtest.h>
 
+#include "test_support.hpp"
+
 namespace {
 namespace fs = std::filesystem;
 
-struct CliResult {
-    int code;
-    std::string out, err;
-};
+using CliResult = rtcost::test::CliRun;
+using rtcost::test::slurp;
 
 fs::path dir() {
     fs::path d = fs::temp_directory_path() / ("rtcost_relcli_" + std::to_string(::getpid()));
@@ -27,21 +25,8 @@ fs::path dir() {
     return d;
 }
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
 // Runs the binary with a time limit (`timeout` kills a hang, which then fails the test).
-CliResult rtcost(const std::string& args, int seconds = 60) {
-    const fs::path d = dir();
-    const std::string cmd = "timeout " + std::to_string(seconds) + " " + RTCOST_CLI + " " + args + " > " +
-                            (d / "out").string() + " 2> " + (d / "err").string() + " < /dev/null";
-    const int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(d / "out"), slurp(d / "err")};
-}
+CliResult rtcost(const std::string& args, int seconds = 60) { return rtcost::test::run_cli(args, seconds); }
 
 fs::path file(const std::string& name, const std::string& bytes) {
     fs::path p = dir() / name;

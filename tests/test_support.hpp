@@ -1,12 +1,16 @@
 #pragma once
 // Helpers shared by the tests: where the shared scenes are, the hard rays every hierarchy must
-// get right, and the comparison of two hit lists.
+// get right, the comparison of two hit lists, one ray's counters, files and the CLI.
 
 #include <gtest/gtest.h>
+#include <sys/wait.h>
+#include <unistd.h>
 
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <sstream>
 #include <string>
 #include <vector>
 
@@ -126,6 +130,42 @@ inline void expect_variants_match_brute(const Scene& s, std::span<const Ray> ray
         EXPECT_EQ(count_mismatches(want, closest_hits(*h, rays), 0.0f, &first), 0u)
             << what << " " << name << " " << ::testing::PrintToString(set) << ": " << first;
     }
+}
+
+/// The counters of one closest-hit query of `r`; `hit` is reset first and receives the hit.
+inline RayCounters count_one(const Hierarchy& h, const Ray& r, Hit& hit) {
+    RayCounters c;
+    hit = Hit{};
+    h.closest(r, hit, c);
+    return c;
+}
+
+/// The whole of file `p` (empty when it cannot be read).
+inline std::string slurp(const std::filesystem::path& p) {
+    std::ifstream in(p, std::ios::binary);
+    std::stringstream ss;
+    ss << in.rdbuf();
+    return ss.str();
+}
+
+/// How a run of the rtcost binary ended: its exit code (-1: killed), stdout and stderr.
+struct CliRun {
+    int code;
+    std::string out, err;
+};
+
+/// Runs the rtcost binary (RTCOST_CLI) with `args` and stdin from /dev/null, its output captured
+/// through files in a directory of this process. With `seconds` > 0 `timeout` kills a hang (exit
+/// 124), which then fails the test instead of stalling the suite.
+inline CliRun run_cli(const std::string& args, int seconds = 0) {
+    const std::filesystem::path d =
+        std::filesystem::temp_directory_path() / ("rtcost_test_cli_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(d);
+    const std::string limit = seconds > 0 ? "timeout " + std::to_string(seconds) + " " : "";
+    const std::string cmd = limit + RTCOST_CLI + " " + args + " > " + (d / "out").string() + " 2> " +
+                            (d / "err").string() + " < /dev/null";
+    const int status = std::system(cmd.c_str());
+    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(d / "out"), slurp(d / "err")};
 }
 
 struct Measured {

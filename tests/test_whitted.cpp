@@ -12,8 +12,6 @@
 #include <set>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
-#include <sys/wait.h>
 #include <unistd.h>
 
 #include "rtcost/whitted.hpp"
@@ -381,10 +379,9 @@ TEST(Render, WritePngIsAtomicAndNamesTheFileOnFailure) {
 }
 
 // The command line.
-struct CliRun {
-    int code;
-    std::string out, err;
-};
+using test::CliRun;
+using test::run_cli;
+using test::slurp;
 
 fs::path temp_dir() {
     fs::path d = fs::temp_directory_path() / ("rtcost_rayscli_" + std::to_string(::getpid()));
@@ -392,25 +389,10 @@ fs::path temp_dir() {
     return d;
 }
 
-std::string slurp(const fs::path& p) {
-    std::ifstream in(p, std::ios::binary);
-    std::stringstream ss;
-    ss << in.rdbuf();
-    return ss.str();
-}
-
-CliRun run(const std::string& args) {
-    fs::path d = temp_dir();
-    std::string cmd = std::string(RTCOST_CLI) + " " + args + " > " + (d / "out").string() + " 2> " +
-                      (d / "err").string() + " < /dev/null";
-    int status = std::system(cmd.c_str());
-    return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, slurp(d / "out"), slurp(d / "err")};
-}
-
 TEST(RaysCli, SpdJsonCountsMatchTheFileAndTheLibrary) {
     RTCOST_REQUIRE_SPD("gears");
     fs::path out = temp_dir() / "gears.rays";
-    CliRun r = run("rays " + test::spd_path("gears") + " --dist spd --size 64x64 --out " + out.string() + " --json");
+    CliRun r = run_cli("rays " + test::spd_path("gears") + " --dist spd --size 64x64 --out " + out.string() + " --json");
     ASSERT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(r.err.empty()) << r.err;
     auto j = nlohmann::json::parse(r.out);
@@ -443,9 +425,9 @@ TEST(RaysCli, SameSeedSameBytesOtherSeedOtherBytes) {
     fs::path d = temp_dir();
     for (const char* dist : {"lines", "diffuse", "ao", "spd"}) {
         std::string base = "rays " + test::spd_path("balls") + " --dist " + dist + " --size 24x24 --count 5000 -q --out ";
-        ASSERT_EQ(run(base + (d / "a.rays").string() + " --seed 7").code, 0) << dist;
-        ASSERT_EQ(run(base + (d / "b.rays").string() + " --seed 7").code, 0) << dist;
-        ASSERT_EQ(run(base + (d / "c.rays").string() + " --seed 8").code, 0) << dist;
+        ASSERT_EQ(run_cli(base + (d / "a.rays").string() + " --seed 7").code, 0) << dist;
+        ASSERT_EQ(run_cli(base + (d / "b.rays").string() + " --seed 7").code, 0) << dist;
+        ASSERT_EQ(run_cli(base + (d / "c.rays").string() + " --seed 8").code, 0) << dist;
         std::string a = slurp(d / "a.rays");
         EXPECT_GT(a.size(), 0u) << dist;
         EXPECT_EQ(a, slurp(d / "b.rays")) << dist;
@@ -458,7 +440,7 @@ TEST(RaysCli, TraceSpdGivesTheSameCountsForEveryHierarchy) {
     RTCOST_REQUIRE_SPD("rings");
     nlohmann::json first;
     for (const char* h : {"bvh-sah", "kd-median", "grid"}) {
-        CliRun r = run("trace " + test::spd_path("rings") + " -H " + h + " --rays spd --size 48x48 --json");
+        CliRun r = run_cli("trace " + test::spd_path("rings") + " -H " + h + " --rays spd --size 48x48 --json");
         ASSERT_EQ(r.code, 0) << r.err;
         auto by_kind = nlohmann::json::parse(r.out)["trace"]["by_kind"];
         for (const char* k : {"eye", "reflection", "shadow"}) {
@@ -475,23 +457,23 @@ TEST(RaysCli, TraceSpdGivesTheSameCountsForEveryHierarchy) {
 TEST(RaysCli, BadInputExitsTwoAndWritesNothing) {
     fs::path out = temp_dir() / "never.rays";
     fs::remove(out);
-    CliRun r = run("rays builtin:tetra:2 --dist spd --size 0x5 --out " + out.string());
+    CliRun r = run_cli("rays builtin:tetra:2 --dist spd --size 0x5 --out " + out.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("--size"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
-    r = run("rays builtin:tetra:2 --dist nosuch --out " + out.string());
+    r = run_cli("rays builtin:tetra:2 --dist nosuch --out " + out.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find("nosuch"), std::string::npos) << r.err;
     EXPECT_FALSE(fs::exists(out));
     fs::path bad = temp_dir() / "no_dir" / "x.rays";
-    r = run("rays builtin:tetra:2 --dist camera --size 4x4 --out " + bad.string());
+    r = run_cli("rays builtin:tetra:2 --dist camera --size 4x4 --out " + bad.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_NE(r.err.find(bad.string()), std::string::npos) << r.err;
 }
 
 TEST(RenderCli, WritesPngOfTheRequestedSize) {
     fs::path out = temp_dir() / "balls.png";
-    CliRun r = run("render builtin:balls:2 --size 40x30 -o " + out.string() + " --json");
+    CliRun r = run_cli("render builtin:balls:2 --size 40x30 -o " + out.string() + " --json");
     ASSERT_EQ(r.code, 0) << r.err;
     auto j = nlohmann::json::parse(r.out);
     EXPECT_EQ(j["width"], 40);
@@ -508,7 +490,7 @@ TEST(RenderCli, WritesPngOfTheRequestedSize) {
     EXPECT_GT(colours.size(), 50u);
     fs::path bad = temp_dir() / "never.png";
     fs::remove(bad);
-    r = run("render builtin:balls:2 --size 40 -o " + bad.string());
+    r = run_cli("render builtin:balls:2 --size 40 -o " + bad.string());
     EXPECT_EQ(r.code, 2);
     EXPECT_FALSE(fs::exists(bad));
 }

@@ -14,7 +14,7 @@ TEST(BvhWide, NodesHoldAtMostWidthChildrenAndEveryPrimitiveOnce) {
         const int w = set[0] == "width=4" ? 4 : 8;
         const ModelTree t = h->model_tree();
         ASSERT_FALSE(t.nodes.empty());
-        EXPECT_EQ(t.family, "bvh");
+        EXPECT_EQ(t.family, ModelFamily::Bvh);
         std::vector<int> seen(s.size(), 0);
         for (const ModelNode& n : t.nodes) {
             if (n.leaf) {

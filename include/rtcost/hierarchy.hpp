@@ -5,7 +5,8 @@
 ///
 /// A hierarchy lives in its own folder `src/hierarchy/<name>/`: a builder, one traversal
 /// template over the counting policy (stats.hpp), and a registration. Nothing else changes when
-/// a hierarchy is added.
+/// a hierarchy is added. What only its author needs (HierarchyImpl, test_prim) is in the
+/// library's internal `src/hierarchy/common/impl.hpp`.
 
 #include <functional>
 #include <map>
@@ -56,9 +57,22 @@ struct ModelNode {
     float beam_u[2] = {-1, 1}, beam_v[2] = {-1, 1};
 };
 
+/// A hierarchy's family, as the model tree declares it: the `paper` preset charges each
+/// family's nodes by the seed paper's formula for it.
+enum class ModelFamily : std::uint8_t {
+    Bvh,     ///< bounding volume hierarchies (and brute force, a one-leaf BVH)
+    Bsp,     ///< Kaplan's BSP tree
+    Octree,  ///< Glassner's octree
+    Kd,      ///< kd-trees
+    Grid,    ///< uniform grids
+    Rc5d,    ///< Arvo and Kirk's 5D ray classification
+};
+
 /// The flags of a model tree: what the nodes alone do not say about the traversal.
 struct ModelFlags {
-    std::string family;                ///< "bvh", "bsp", "octree", "kd", "grid", "rc5d"
+    /// Every hierarchy names its family: there is no default to fall back on.
+    explicit ModelFlags(ModelFamily f) : family(f) {}
+    ModelFamily family;
     /// Leaves are found by descending from the root for every cell (Kaplan's and Glassner's
     /// `locate` traversal): each leaf visit pays the operations of all its ancestors again.
     bool locate = false;
@@ -81,6 +95,8 @@ struct ModelFlags {
 /// contiguous. Binary for space subdivisions; a BVH node may have more than two children
 /// (Goldsmith and Salmon's trees are n-ary), each entered through its own box test.
 struct ModelTree : ModelFlags {
+    /// An empty tree (a hierarchy the model cannot see into); emit_model's flags replace these.
+    ModelTree() : ModelFlags(ModelFamily::Bvh) {}
     std::vector<ModelNode> nodes;
     std::vector<std::uint32_t> prims;  ///< leaf primitive references
 };
@@ -193,64 +209,6 @@ private:
                                                       const std::vector<std::string>&);
     double build_seconds_ = 0;
 };
-
-/// Implements the four query overloads of Hierarchy from one traversal template of `Derived`:
-///   template <class C, Query Q> bool trace(const Ray&, Hit&, C& counting) const;
-/// which returns true on a hit. This is how counting stays a compile-time policy.
-template <class Derived>
-class HierarchyImpl : public Hierarchy {
-public:
-    using Hierarchy::Hierarchy;
-    void closest(const Ray& ray, Hit& hit) const final {
-        NoCount c;
-        self().template trace<NoCount, Query::Closest>(ray, hit, c);
-    }
-    void closest(const Ray& ray, Hit& hit, RayCounters& counters) const final {
-        Count c{counters};
-        ++counters.rays;
-        self().template trace<Count, Query::Closest>(ray, hit, c);
-    }
-    bool any(const Ray& ray, Hit& hit) const final {
-        NoCount c;
-        return self().template trace<NoCount, Query::Any>(ray, hit, c);
-    }
-    bool any(const Ray& ray, Hit& hit, RayCounters& counters) const final {
-        Count c{counters};
-        ++counters.rays;
-        return self().template trace<Count, Query::Any>(ray, hit, c);
-    }
-
-    void all(const Ray& ray, Hit& hit) const final {
-        NoCount c;
-        self().template trace<NoCount, Query::All>(ray, hit, c);
-    }
-    void all(const Ray& ray, Hit& hit, RayCounters& counters) const final {
-        Count c{counters};
-        ++counters.rays;
-        self().template trace<Count, Query::All>(ray, hit, c);
-    }
-
-private:
-    const Derived& self() const { return static_cast<const Derived&>(*this); }
-};
-
-/// Tests primitive `id` against `ray` and, when it is hit nearer than `hit.t`, records it.
-/// Counts one primitive test of the primitive's kind. Shared by every traversal's leaves.
-/// Traversals implement Query::All by never terminating early or culling by `hit.t`
-/// (`if constexpr (Q != Query::All)` around every such test).
-template <class C>
-inline bool test_prim(const Scene& scene, std::uint32_t id, const Ray& ray, Hit& hit, C& counting) {
-    counting.prim(scene.kind(id));
-    Ray r = ray;
-    r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
-    float t;
-    if (scene.intersect(id, r, t)) {
-        hit.t = t;
-        hit.prim = static_cast<std::int32_t>(id);
-        return true;
-    }
-    return false;
-}
 
 /// A registered hierarchy: its name, a one-line description, its parameters and its builder.
 struct HierarchyInfo {

@@ -23,7 +23,6 @@ public:
     bool begin(const ModelFlags& f) override {
         flags_ = f;
         begun_ = true;
-        fam_ = family_of(f.family);
         paper_ = opt_.preset == Preset::Paper;
         terminate_ = terminates(f, opt_.query);
         // Each primitive's bounds, area and kind in scene order (the scene's summaries, or
@@ -285,7 +284,7 @@ private:
         const ModelNode& m = o.m;
         const double times = flags_.locate && !m.leaf ? S.leaf_visits : p;
         const double gated = flags_.locate && !m.leaf ? times : pg;
-        charge_visit(S.c, m, fam_, paper_, times, gated, 0.5, pb);
+        charge_visit(S.c, m, flags_.family, paper_, times, gated, 0.5, pb);
         if (m.step) {
             S.c.steps += times;
             S.add_depth(o.tdepth, times);
@@ -294,8 +293,7 @@ private:
 
     const Scene& scene_;
     ModelOptions opt_;
-    ModelFlags flags_;
-    Family fam_ = Family::Bvh;
+    ModelFlags flags_{ModelFamily::Bvh};  // begin() sets the tree's own
     bool paper_ = false, terminate_ = false, begun_ = false, done_ = false;
     std::span<const PrimSummary> sums_;
     std::vector<PrimSummary> own_sums_;

@@ -73,14 +73,10 @@ struct Walk {
 /// closest-hit one skips what lies beyond, unless the traversal visits everything (ModelFlags::cull).
 inline bool terminates(const ModelFlags& f, Query q) { return q == Query::Any || (q == Query::Closest && f.cull); }
 
-/// The families whose `paper` node costs differ.
-enum class Family { Bvh, Grid, Rc5d, Kd, Subdivision };
-Family family_of(const std::string& f);
-
 /// Adds the operations of one visit of `m` to `c`, scaled by `p` (visits) and `pg` (visits that
 /// pass the node's bounding volume). `gamma` and `pb` (P of the first child, 0 without
 /// termination) enter the paper's Kaplan/Glassner term only.
-void charge_visit(CostVector& c, const ModelNode& m, Family f, bool paper, double p, double pg, double gamma,
+void charge_visit(CostVector& c, const ModelNode& m, ModelFamily f, bool paper, double p, double pg, double gamma,
                   double pb);
 
 /// The recursion: q(child | parent visited) for every node from per-node probabilities (the

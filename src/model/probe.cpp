@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "hierarchy/common/impl.hpp"
 #include "model_internal.hpp"
 #include "rtcost/error.hpp"
 #include "rtcost/sample.hpp"

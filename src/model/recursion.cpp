@@ -6,18 +6,10 @@
 
 namespace rtcost::model {
 
-Family family_of(const std::string& f) {
-    if (f == "bvh") return Family::Bvh;
-    if (f == "grid") return Family::Grid;
-    if (f == "rc5d") return Family::Rc5d;
-    if (f == "kd") return Family::Kd;
-    return Family::Subdivision;  // Kaplan's BSP, Glassner's octree
-}
-
 /// Adds the operations of one visit of `m` to `c`, scaled by `p` (visits) and `pg` (visits that
 /// pass the node's bounding volume). `gamma` and `pb` (P of the first child, 0 without
 /// termination) enter the paper's Kaplan/Glassner term only.
-void charge_visit(CostVector& c, const ModelNode& m, Family f, bool paper, double p, double pg, double gamma,
+void charge_visit(CostVector& c, const ModelNode& m, ModelFamily f, bool paper, double p, double pg, double gamma,
                   double pb) {
     if (!paper) {
         c.box += p * m.box;
@@ -26,17 +18,26 @@ void charge_visit(CostVector& c, const ModelNode& m, Family f, bool paper, doubl
         c.classify += pg * m.classify;
         return;
     }
-    if (f == Family::Bvh) {
+    if (f == ModelFamily::Bvh) {
         c.box += p;  // the paper charges a node's own box test when it is entered
-    } else if (!m.leaf) {
-        if (f == Family::Grid) c.hop += p;
-        else if (f == Family::Rc5d) c.classify += p;
-        else if (f == Family::Kd) { c.plane += p; c.box += p; }
-        else {
+        return;
+    }
+    if (m.leaf) return;
+    // No default: a new family must say which formula charges its interior nodes.
+    switch (f) {
+        case ModelFamily::Bvh: break;
+        case ModelFamily::Grid: c.hop += p; break;
+        case ModelFamily::Rc5d: c.classify += p; break;
+        case ModelFamily::Kd:
+            c.plane += p;
+            c.box += p;
+            break;
+        case ModelFamily::Bsp:
+        case ModelFamily::Octree:
             // Kaplan/Glassner: 1_cmp + [g (1 - P_B) + (1 - g)] n_f, the far region's entry.
             c.plane += p;
             c.box += p * (gamma * (1 - pb) + (1 - gamma));
-        }
+            break;
     }
 }
 
@@ -55,10 +56,9 @@ Prediction recurse(const ModelTree& t, const Walk& w, const std::vector<NodeProb
         if (depth >= static_cast<int>(out.visits_by_depth.size())) out.visits_by_depth.resize(depth + 1, 0.0);
         out.visits_by_depth[depth] += p;
     };
-    const Family fam = family_of(t.family);
     auto charge = [&](const ModelNode& m, double p, double pg, std::size_t i) {
         const double pb = paper && terminate && !m.leaf ? prob[m.first].p_hit : 0.0;
-        charge_visit(c, m, fam, paper, p, pg, prob[i].gamma, pb);
+        charge_visit(c, m, t.family, paper, p, pg, prob[i].gamma, pb);
     };
 
     // Primitive kinds in scene order: looking each reference up in scene.prims would miss the cache.

@@ -3,26 +3,12 @@
 // primitive chosen uniformly at random, so it meets that primitive or something in front of it.
 #include <cmath>
 #include <numbers>
-#include <random>
 
 #include "rtcost/rays.hpp"
+#include "util/rng.hpp"
 
 namespace rtcost {
 namespace {
-
-// The same construction as the other distributions (raw 53 bits of mt19937_64), so the rays are
-// identical across standard libraries.
-struct Rng {
-    std::mt19937_64 engine;
-    explicit Rng(std::uint64_t seed) : engine(seed) {}
-    double uniform() { return static_cast<double>(engine() >> 11) * 0x1p-53; }
-    Vec3 direction() {
-        double z = 1 - 2 * uniform();
-        double phi = 2 * std::numbers::pi * uniform();
-        double r = std::sqrt(std::max(0.0, 1 - z * z));
-        return {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
-    }
-};
 
 Vec3 on_triangle(Vec3 a, Vec3 b, Vec3 c, Rng& rng) {
     const double s = std::sqrt(rng.uniform()), u = rng.uniform();

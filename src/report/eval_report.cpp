@@ -4,6 +4,7 @@
 #include <algorithm>
 
 #include "rtcost/evaluate.hpp"
+#include "rtcost/rays.hpp"
 #include "rtcost/report.hpp"
 
 namespace rtcost {
@@ -20,9 +21,13 @@ json cost_json(const CostVector& c, double scalar) {
 
 double relative(double predicted, double measured) { return measured > 0 ? (predicted - measured) / measured : 0.0; }
 
-/// The query each ray kind of the test rays is traced with.
+/// The query each ray kind of the test rays is traced with (the result names kinds by
+/// ray_kind_name; a name of no kind is traced with the main query).
 std::string_view query_of(const EvalResult& r, const std::string& kind) {
-    return kind == "shadow" || kind == "ao" ? query_name(r.occlusion) : query_name(r.query);
+    for (int k = 0; k < kRayKinds; ++k)
+        if (ray_kind_name(static_cast<RayKind>(k)) == kind)
+            return is_occlusion(static_cast<RayKind>(k)) ? query_name(r.occlusion) : query_name(r.query);
+    return query_name(r.query);
 }
 
 json queries_json(const EvalResult& r) {

@@ -10,6 +10,7 @@
 
 #include "rays/whitted_tracer.hpp"
 #include "rtcost/error.hpp"
+#include "rtcost/rays.hpp"
 #include "rtcost/trace.hpp"
 
 namespace rtcost {
@@ -60,7 +61,7 @@ PixelCosts pixel_costs(const Hierarchy& h, const PixelCostOptions& opt) {
     pc.pixels.resize(eye.size());
     std::vector<RayCounters> rows(static_cast<std::size_t>(opt.height));
     auto occluded = [&](RayKind k) {
-        return (k == RayKind::Shadow || k == RayKind::AO) && opt.occlusion == Query::Any;
+        return is_occlusion(k) && opt.occlusion == Query::Any;
     };
     detail::run_rows(
         opt.height, opt.threads,

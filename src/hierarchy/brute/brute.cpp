@@ -1,6 +1,6 @@
 // `brute`: tests every primitive for every ray. The reference every other hierarchy is checked
 // against; it has no structure, so its structural statistics describe one leaf holding all.
-#include "rtcost/hierarchy.hpp"
+#include "../common/impl.hpp"
 
 namespace rtcost {
 namespace {
@@ -26,8 +26,7 @@ public:
 
     /// One leaf holding every primitive, entered with no box test.
     bool emit_model(ModelSink& sink) const override {
-        ModelFlags f;
-        f.family = "bvh";
+        ModelFlags f(ModelFamily::Bvh);
         f.per_ray_box = 0;
         f.gated = false;  // a ray that misses the scene's box still tests every primitive
         if (!sink.begin(f)) return true;

@@ -88,8 +88,7 @@ StructureStats Bsp::compute_tree() const {
 // One model node per BSP node (same indices): a visit costs one plane compare and is one step;
 // with `locate` the model charges every leaf visit its whole descent again.
 bool Bsp::emit_model(ModelSink& sink) const {
-    ModelFlags f;
-    f.family = "bsp";
+    ModelFlags f(ModelFamily::Bsp);
     f.locate = o_.locate;
     f.per_ray_box = 1;
     if (!sink.begin(f) || nodes_.empty()) return true;

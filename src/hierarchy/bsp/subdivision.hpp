@@ -27,7 +27,7 @@
 #include <vector>
 
 #include "../common/spatial.hpp"
-#include "rtcost/hierarchy.hpp"
+#include "../common/impl.hpp"
 
 namespace rtcost::subdiv {
 

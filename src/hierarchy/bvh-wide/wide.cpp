@@ -237,8 +237,7 @@ StructureStats BvhWide::compute_structure() const {
 }
 
 bool BvhWide::emit_model(ModelSink& sink) const {
-    ModelFlags f;
-    f.family = "bvh";
+    ModelFlags f(ModelFamily::Bvh);
     if (!sink.begin(f) || d_->root_count == 0) return true;
     ModelNode root;
     root.region = root.bv = d_->root_box;

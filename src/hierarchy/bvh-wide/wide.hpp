@@ -13,7 +13,7 @@
 #include <string>
 #include <vector>
 
-#include "rtcost/hierarchy.hpp"
+#include "../common/impl.hpp"
 
 namespace rtcost::wide {
 

@@ -24,8 +24,7 @@ StructureStats Bvh::compute_structure() const {
 }
 
 bool Bvh::emit_model(ModelSink& sink) const {
-    ModelFlags f;
-    f.family = "bvh";
+    ModelFlags f(ModelFamily::Bvh);
     f.cull = ordered_;
     if (!sink.begin(f) || d_.nodes.empty()) return true;
     auto emit = [&](auto&& self, std::uint32_t i) -> void {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "rtcost/hierarchy.hpp"
+#include "../common/impl.hpp"
 #include "../common/leaf_prims.hpp"
 
 namespace rtcost::bvh {

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "rtcost/hierarchy.hpp"
+#include "impl.hpp"
 
 namespace rtcost {
 

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "../common/spatial.hpp"
-#include "rtcost/hierarchy.hpp"
+#include "../common/impl.hpp"
 
 namespace rtcost::grid {
 

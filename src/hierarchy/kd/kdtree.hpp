@@ -37,7 +37,7 @@
 #include <vector>
 
 #include "../common/spatial.hpp"
-#include "rtcost/hierarchy.hpp"
+#include "../common/impl.hpp"
 
 namespace rtcost::kd {
 

@@ -78,8 +78,7 @@ StructureStats Octree::compute_tree() const {
 // carry regions and planes for the probabilities (no step, no operations). A Z-level node's
 // children are the octants (x, y, 0) and (x, y, 1).
 bool Octree::emit_model(ModelSink& sink) const {
-    ModelFlags f;
-    f.family = "octree";
+    ModelFlags f(ModelFamily::Octree);
     f.locate = o_.locate;
     f.per_ray_box = 1;
     if (!sink.begin(f) || nodes_.empty()) return true;

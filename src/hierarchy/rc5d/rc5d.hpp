@@ -46,7 +46,7 @@
 #include <string_view>
 #include <vector>
 
-#include "rtcost/hierarchy.hpp"
+#include "../common/impl.hpp"
 
 namespace rtcost::rc5d {
 
