@@ -281,25 +281,11 @@ TEST(BspOctreeAssign, ExactNeverReferencesFewerCellsThanTheSurfaceMeets) {
 
 // --- hits ------------------------------------------------------------------------------------
 
-const std::vector<std::pair<std::string, Set>> kVariants = {
-    {"bsp", {}},
-    {"bsp", {"traversal=recursive"}},
-    {"bsp", {"assign=exact", "mailbox=1"}},
-    {"bsp", {"traversal=recursive", "assign=exact", "mailbox=1"}},
-    {"bsp", {"max_depth=0"}},
-    {"bsp", {"max_depth=0", "traversal=recursive"}},
-    {"bsp", {"max_prims=1", "max_depth=30", "growth=7"}},
-    {"octree", {}},
-    {"octree", {"traversal=recursive"}},
-    {"octree", {"assign=exact", "mailbox=1"}},
-    {"octree", {"traversal=recursive", "max_prims=4", "mailbox=1"}},
-    {"octree", {"max_depth=0"}},
-    {"octree", {"max_depth=0", "traversal=recursive"}},
-    {"octree", {"max_depth=10", "max_prims=2"}},
-};
+// Kaplan's and Glassner's own hit checks: the variants bsp and octree declare for them.
+std::vector<Variant> subdivision_variants() { return registered_variants(kTestSubdivision); }
 
 void expect_all_match(const Scene& s, const std::vector<Ray>& rays, const std::string& what,
-                      const std::vector<Variant>& variants = kVariants) {
+                      const std::vector<Variant>& variants = subdivision_variants()) {
     expect_variants_match_brute(s, rays, what, variants);
 }
 
@@ -393,7 +379,7 @@ TEST(BspOctreeHits, RaysInSplitPlanesMatchBruteForce) {
             auto h = build_hierarchy(s, name);
             auto rays = plane_rays(*h, s.bounds(), 99);
             std::vector<std::pair<std::string, Set>> variants;
-            for (const auto& v : kVariants)
+            for (const auto& v : subdivision_variants())
                 if (v.first == name) variants.push_back(v);
             expect_all_match(s, rays, std::string(scene) + " plane rays", variants);
         }
@@ -467,7 +453,7 @@ TEST(BspOctreeHits, AnyHitAndAllHitsAgreeWithBruteForce) {
     auto rays = hard_rays(s, 4000, 13);
     auto brute = build_hierarchy(s, "brute");
     std::vector<Hit> want = closest_hits(*brute, rays);
-    for (const auto& [name, set] : kVariants) {
+    for (const auto& [name, set] : subdivision_variants()) {
         auto h = build_hierarchy(s, name, set);
         std::size_t bad = 0;
         for (std::size_t i = 0; i < rays.size(); ++i) {
@@ -562,7 +548,7 @@ TEST(BspOctreeCounters, RayMissingTheBoxCostsOneBoxTestAndEmptySceneToo) {
     Scene s = abc_scene();
     Scene empty;
     empty.finalize();
-    for (const auto& [name, set] : kVariants) {
+    for (const auto& [name, set] : subdivision_variants()) {
         for (const Scene* sc : {&s, &empty}) {
             auto h = build_hierarchy(*sc, name, set);
             Hit hit;
@@ -577,7 +563,7 @@ TEST(BspOctreeCounters, RayMissingTheBoxCostsOneBoxTestAndEmptySceneToo) {
 TEST(BspOctreeCounters, CountingDoesNotChangeHitsAndInvariantsHold) {
     Scene s = builtin_scene("balls", 2);
     auto rays = hard_rays(s, 5000, 3);
-    for (const auto& [name, set] : kVariants) {
+    for (const auto& [name, set] : subdivision_variants()) {
         auto h = build_hierarchy(s, name, set);
         TraceOptions opt;
         TraceResult fast = trace_rays(*h, rays, opt);

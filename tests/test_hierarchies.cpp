@@ -8,35 +8,8 @@
 namespace rtcost::test {
 namespace {
 
-// The hierarchies checked here, with the parameter variants that change traversal or build.
-const std::vector<std::pair<std::string, std::vector<std::string>>> kVariants = {
-    {"bvh-median", {}},
-    {"bvh-median", {"order=none"}},
-    {"bvh-gs", {}},
-    {"bvh-gs", {"seed=0"}},
-    {"bvh-gs", {"seed=7", "max_prims=3"}},
-    {"bvh-sah", {}},
-    {"bvh-sah", {"sweep=1", "order=none"}},
-    {"grid", {}},
-    {"grid", {"res=woo"}},
-    {"grid", {"res=regular", "assign=exact"}},
-    {"grid", {"res=hetero", "density=8", "assign=exact", "mailbox=1"}},
-    {"grid", {"res=13x7x9"}},
-    {"rc5d", {}},
-    {"rc5d", {"max_prims=2", "max_depth=45"}},
-    {"rc5d", {"build=eager", "max_depth=10"}},
-    {"bsp", {}},
-    {"bsp", {"traversal=recursive", "assign=exact", "mailbox=1"}},
-    {"octree", {}},
-    {"octree", {"traversal=recursive", "max_prims=4"}},
-    {"kd-median", {}},
-    {"kd-sah", {}},
-    {"kd-sah", {"assign=exact", "mailbox=1"}},
-    {"bvh-wide", {}},
-    {"bvh-wide", {"width=4"}},
-    {"bvh-wide", {"width=8", "simd=baseline", "max_prims=1"}},
-    {"bvh-wide", {"width=4", "simd=baseline", "max_prims=8"}},
-};
+// The hierarchies checked here are the kTestHits variants each registration declares
+// (registered_variants): the parameter sets that change traversal or build.
 
 struct Reference {
     Scene scene;
@@ -99,7 +72,7 @@ TEST_P(SceneCheck, BruteForceHitsSomethingAndEmbreeAgrees) {
 TEST_P(SceneCheck, EveryHierarchyMatchesBruteForceExactlyAndAnyHitAgrees) {
     Reference& r = ref();
     const std::vector<Hit>& brute = r.brute();
-    for (const auto& [name, set] : kVariants) {
+    for (const auto& [name, set] : registered_variants(kTestHits)) {
         auto h = build_hierarchy(r.scene, name, set);
         std::vector<Hit> got = closest_hits(*h, r.rays);
         std::string first;
@@ -125,7 +98,7 @@ TEST_P(SceneCheck, EveryHierarchyMatchesBruteForceExactlyAndAnyHitAgrees) {
 TEST_P(SceneCheck, CountingDoesNotChangeHitsAndInvariantsHold) {
     Reference& r = ref();
     std::span<const Ray> rays = std::span(r.rays).first(20000);
-    for (const auto& [name, set] : kVariants) {
+    for (const auto& [name, set] : registered_variants(kTestHits)) {
         auto h = build_hierarchy(r.scene, name, set);
         StructureStats s = h->structure();
         const ModelFamily family = h->model_tree().family;

@@ -62,14 +62,7 @@ TEST(ModelSampled, ReproducesTheTrainingRaysCountsForEveryHierarchyAndQuery) {
     std::vector<Ray> rays = camera_rays(s.camera, 48, 48);
     std::vector<Ray> more = random_rays(s.bounds(), 3000, 21);
     rays.insert(rays.end(), more.begin(), more.end());
-    const std::vector<Variant> variants = {
-        {"bvh-median", {}},   {"bvh-gs", {}},       {"bvh-sah", {}},      {"bvh-sah", {"order=none"}},
-        {"bvh-wide", {}},     {"bvh-wide", {"width=4"}},
-        {"kd-median", {}},    {"kd-sah", {}},       {"grid", {}},         {"grid", {"res=woo"}},
-        {"bsp", {}},          {"bsp", {"traversal=recursive"}},           {"octree", {}},
-        {"octree", {"traversal=recursive", "max_prims=2"}},               {"rc5d", {"build=eager", "max_depth=10"}},
-    };
-    for (const auto& [name, set] : variants) {
+    for (const auto& [name, set] : registered_variants(kTestSampled)) {
         auto h = build_hierarchy(s, name, set);
         ModelTree t = h->model_tree();
         for (Query q : {Query::Closest, Query::Any, Query::All}) {
@@ -108,11 +101,7 @@ class ModelExactSpd : public ::testing::TestWithParam<std::string> {};
 TEST_P(ModelExactSpd, EveryHierarchyPredictsAllHitsOfLines) {
     RTCOST_REQUIRE_SPD(GetParam());
     Scene s = load_scene(spd_path(GetParam()));
-    const std::vector<Variant> variants = {
-        {"bvh-median", {}}, {"bvh-gs", {"seed=1"}}, {"bvh-sah", {}}, {"kd-median", {}}, {"kd-sah", {}},
-        {"grid", {}},       {"bsp", {}},            {"octree", {}},  {"rc5d", {"build=eager", "max_depth=8"}},
-    };
-    for (const auto& [name, set] : variants) expect_model_exact(s, name, set, 100000, 4);
+    for (const auto& [name, set] : registered_variants(kTestSpdModel)) expect_model_exact(s, name, set, 100000, 4);
 }
 
 INSTANTIATE_TEST_SUITE_P(Spd, ModelExactSpd,
@@ -126,9 +115,7 @@ TEST(ModelStream, InPlaceEqualsTheMaterialisedTreeForEveryHierarchy) {
     int modelled = 0;
     for (const HierarchyInfo* info : hierarchies()) {
         for (const Scene* s : {&balls, &tetra}) {
-            std::vector<std::string> set;
-            if (info->name == "rc5d") set = {"build=eager", "max_depth=12"};
-            auto h = build_hierarchy(*s, info->name, set);
+            auto h = build_hierarchy(*s, info->name, model_tree_set(*info));
             const ModelTree t = h->model_tree();
             ASSERT_EQ(h->modelled(), !t.nodes.empty()) << info->name;
             if (!h->modelled()) {
@@ -158,9 +145,12 @@ TEST(ModelStream, InPlaceEqualsTheMaterialisedTreeForEveryHierarchy) {
 
 TEST(ModelStream, TheMaterialisedTreeKeepsChildrenContiguousAndDepthsInOrder) {
     Scene s = builtin_scene("balls", 2);
-    for (const char* name : {"bvh-gs", "kd-median", "octree", "grid"}) {
-        const ModelTree t = build_hierarchy(s, name)->model_tree();
-        ASSERT_FALSE(t.nodes.empty());
+    for (const HierarchyInfo* info : hierarchies()) {
+        const std::string& name = info->name;
+        const auto h = build_hierarchy(s, name, model_tree_set(*info));
+        if (!h->modelled()) continue;  // embree
+        const ModelTree t = h->model_tree();
+        ASSERT_FALSE(t.nodes.empty()) << name;
         std::vector<int> parents(t.nodes.size(), 0);
         std::size_t refs = 0;
         for (std::size_t i = 0; i < t.nodes.size(); ++i) {

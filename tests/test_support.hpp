@@ -119,6 +119,24 @@ inline std::size_t count_mismatches(std::span<const Hit> want, std::span<const H
 /// A hierarchy to build: its name and its `--set` assignments.
 using Variant = std::pair<std::string, std::vector<std::string>>;
 
+/// The test variants the registered hierarchies declare for `use` (TestUse bits), in registry
+/// order. Read inside a test, never at static initialisation (the registry fills then).
+inline std::vector<Variant> registered_variants(unsigned use) {
+    std::vector<Variant> out;
+    for (const HierarchyInfo* info : hierarchies())
+        for (const TestVariant& v : info->tests)
+            if (v.uses & use) out.push_back({info->name, v.set});
+    return out;
+}
+
+/// The parameters the tests that read a hierarchy's whole model tree build it with: its
+/// kTestModelTree variant, or the defaults.
+inline std::vector<std::string> model_tree_set(const HierarchyInfo& info) {
+    for (const TestVariant& v : info.tests)
+        if (v.uses & kTestModelTree) return v.set;
+    return {};
+}
+
 /// Every variant returns exactly brute force's closest hits for `rays` (ties at shared edges aside).
 inline void expect_variants_match_brute(const Scene& s, std::span<const Ray> rays, const std::string& what,
                                         const std::vector<Variant>& variants) {

@@ -210,6 +210,32 @@ private:
     double build_seconds_ = 0;
 };
 
+/// What the test suites build a test variant of a hierarchy for, a bit each. The suites that
+/// check every hierarchy iterate the registry and pick the variants by these bits, so a new
+/// hierarchy declares its tests in its own registration.
+enum TestUse : unsigned {
+    /// Closest hits equal brute force's, any-hit agrees, counting changes nothing
+    /// (tests/test_hierarchies.cpp).
+    kTestHits = 1u << 0,
+    /// On its own training rays the sampled estimator reproduces the counters, for every query
+    /// (tests/test_model.cpp): the model tree must be complete before tracing (no lazy build).
+    kTestSampled = 1u << 1,
+    /// The geometric estimator is exact for lines on every SPD scene (tests/test_model.cpp; slow,
+    /// so one variant per hierarchy).
+    kTestSpdModel = 1u << 2,
+    /// The parameters of the tests that read the whole model tree (emitted and materialised);
+    /// without such a variant they build the defaults.
+    kTestModelTree = 1u << 3,
+    /// Kaplan's BSP and Glassner's octree's own hit checks (tests/test_bsp_octree.cpp).
+    kTestSubdivision = 1u << 4,
+};
+
+/// A parameter set the test suites build a hierarchy with.
+struct TestVariant {
+    std::vector<std::string> set;  ///< `--set` assignments
+    unsigned uses = 0;             ///< TestUse bits: which suites build it
+};
+
 /// A registered hierarchy: its name, a one-line description, its parameters and its builder.
 struct HierarchyInfo {
     std::string name;
@@ -219,6 +245,8 @@ struct HierarchyInfo {
     /// `-H all` takes it over at most this many primitives: beyond, its build or trace is too
     /// slow for a first look, and `eval` says it was left out (naming it still builds it).
     std::size_t all_up_to = std::numeric_limits<std::size_t>::max();
+    /// The variants the test suites check, declared by the hierarchy's registration.
+    std::vector<TestVariant> tests = {};
 };
 
 /// Brute force tests every primitive for every ray: `-H all` takes it on small scenes only.
@@ -237,9 +265,10 @@ std::unique_ptr<Hierarchy> build_hierarchy(const Scene& scene, std::string_view 
                                            const std::vector<std::string>& assignments = {});
 
 /// Registers a hierarchy at static-initialisation time; used once in each hierarchy's folder:
-///   static const rtcost::Registration reg{{"bvh-sah", "...", {...}, builder}};
+///   static const rtcost::Registration reg{{"bvh-sah", "...", {...}, builder}, {{{}, kTestHits}}};
+/// `tests` become `info.tests`.
 struct Registration {
-    explicit Registration(HierarchyInfo info);
+    explicit Registration(HierarchyInfo info, std::vector<TestVariant> tests = {});
 };
 
 }  // namespace rtcost

@@ -104,7 +104,10 @@ void emit_model(const ModelTree& t, ModelSink& sink) {
     emit_subtree(t, 0, sink);
 }
 
-Registration::Registration(HierarchyInfo info) { registry().push_back(std::move(info)); }
+Registration::Registration(HierarchyInfo info, std::vector<TestVariant> tests) {
+    info.tests = std::move(tests);
+    registry().push_back(std::move(info));
+}
 
 std::vector<const HierarchyInfo*> hierarchies() {
     std::vector<const HierarchyInfo*> out;

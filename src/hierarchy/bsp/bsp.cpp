@@ -123,7 +123,14 @@ const Registration reg{
      subdiv::param_specs(20, kMaxDepth, 2),
      [](const Scene& s, const Params& p) {
          return std::make_unique<Bsp>(s, subdiv::read_options<Options>(p, kMaxDepth));
-     }}};
+     }},
+    {{{}, kTestHits | kTestSampled | kTestSpdModel | kTestSubdivision},
+     {{"traversal=recursive", "assign=exact", "mailbox=1"}, kTestHits | kTestSubdivision},
+     {{"traversal=recursive"}, kTestSampled | kTestSubdivision},
+     {{"assign=exact", "mailbox=1"}, kTestSubdivision},
+     {{"max_depth=0"}, kTestSubdivision},
+     {{"max_depth=0", "traversal=recursive"}, kTestSubdivision},
+     {{"max_prims=1", "max_depth=30", "growth=7"}, kTestSubdivision}}};
 
 }  // namespace
 }  // namespace rtcost::bsp

@@ -313,7 +313,11 @@ const Registration reg{
       {"bins", "16", "SAH bins per axis"},
       {"c_trav", "4", "SAH cost of a traversal step, relative to a primitive test (triangles are tested 4 or 8 "
                       "at a time, so leaves are larger than bvh-sah's)"}},
-     build}};
+     build},
+    {{{}, kTestHits | kTestSampled},
+     {{"width=4"}, kTestHits | kTestSampled},
+     {{"width=8", "simd=baseline", "max_prims=1"}, kTestHits},
+     {{"width=4", "simd=baseline", "max_prims=8"}, kTestHits}}};
 
 }  // namespace
 }  // namespace rtcost::wide

@@ -64,7 +64,9 @@ const Registration median_reg{
          o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
          o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
          return std::make_unique<Bvh>(s, "bvh-median", build_median(s, o), ordered(p));
-     }}};
+     }},
+    {{{}, kTestHits | kTestSampled | kTestSpdModel},
+     {{"order=none"}, kTestHits}}};
 
 const Registration gs_reg{
     {"bvh-gs",
@@ -83,7 +85,10 @@ const Registration gs_reg{
          o.seed = static_cast<std::uint64_t>(p.integer("seed", 0, 1LL << 62));
          return std::make_unique<Bvh>(s, "bvh-gs", build_gs(s, o), ordered(p));
      },
-     kLargeScene}};  // insertion from the root, one object at a time: 10 s for a million
+     kLargeScene},  // insertion from the root, one object at a time: 10 s for a million
+    {{{}, kTestHits | kTestSampled | kTestSpdModel},
+     {{"seed=0"}, kTestHits},
+     {{"seed=7", "max_prims=3"}, kTestHits}}};
 
 const Registration sah_reg{
     {"bvh-sah",
@@ -104,7 +109,10 @@ const Registration sah_reg{
          o.c_trav = static_cast<float>(p.real("c_trav", 0, 1e6));
          o.c_isect = static_cast<float>(p.real("c_isect", 1e-6, 1e6));
          return std::make_unique<Bvh>(s, "bvh-sah", build_sah(s, o), ordered(p));
-     }}};
+     }},
+    {{{}, kTestHits | kTestSampled | kTestSpdModel},
+     {{"sweep=1", "order=none"}, kTestHits},
+     {{"order=none"}, kTestSampled}}};
 
 }  // namespace
 }  // namespace rtcost::bvh

@@ -319,7 +319,12 @@ const Registration reg{
          const double density = p.real("density", 1e-3, 1e3);
          const std::array<int, 3> res = resolution(p.str("res"), density, s.size(), s.bounds());
          return std::make_unique<Grid>(s, res, spatial::parse_assign(p), p.flag("mailbox"));
-     }}};
+     }},
+    {{{}, kTestHits | kTestSampled | kTestSpdModel},
+     {{"res=woo"}, kTestHits | kTestSampled},
+     {{"res=regular", "assign=exact"}, kTestHits},
+     {{"res=hetero", "density=8", "assign=exact", "mailbox=1"}, kTestHits},
+     {{"res=13x7x9"}, kTestHits}}};
 
 }  // namespace
 }  // namespace rtcost::grid

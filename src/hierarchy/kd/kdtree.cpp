@@ -178,7 +178,8 @@ const Registration median_reg{
          o.build.boxes = true;
          return std::make_unique<KdTree>(s, "kd-median", build_median(s, o), p.flag("mailbox"));
      },
-     kLargeScene}};  // O(N log^2 N) build: 7 s for a million triangles
+     kLargeScene},  // O(N log^2 N) build: 7 s for a million triangles
+    {{{}, kTestHits | kTestSampled | kTestSpdModel}}};
 
 const Registration sah_reg{
     {"kd-sah",
@@ -198,7 +199,9 @@ const Registration sah_reg{
          o.empty_bonus = static_cast<float>(p.real("empty_bonus", 0, 1));
          return std::make_unique<KdTree>(s, "kd-sah", build_sah(s, o), p.flag("mailbox"));
      },
-     kLargeScene}};  // O(N log^2 N) build: 17 s for a million triangles
+     kLargeScene},  // O(N log^2 N) build: 17 s for a million triangles
+    {{{}, kTestHits | kTestSampled | kTestSpdModel},
+     {{"assign=exact", "mailbox=1"}, kTestHits}}};
 
 }  // namespace
 }  // namespace rtcost::kd

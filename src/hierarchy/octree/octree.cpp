@@ -134,7 +134,16 @@ const Registration reg{
      subdiv::param_specs(8, kMaxDepth, 1),
      [](const Scene& s, const Params& p) {
          return std::make_unique<Octree>(s, subdiv::read_options<Options>(p, kMaxDepth));
-     }}};
+     }},
+    {{{}, kTestHits | kTestSampled | kTestSpdModel | kTestSubdivision},
+     {{"traversal=recursive", "max_prims=4"}, kTestHits},
+     {{"traversal=recursive", "max_prims=2"}, kTestSampled},
+     {{"traversal=recursive"}, kTestSubdivision},
+     {{"assign=exact", "mailbox=1"}, kTestSubdivision},
+     {{"traversal=recursive", "max_prims=4", "mailbox=1"}, kTestSubdivision},
+     {{"max_depth=0"}, kTestSubdivision},
+     {{"max_depth=0", "traversal=recursive"}, kTestSubdivision},
+     {{"max_depth=10", "max_prims=2"}, kTestSubdivision}}};
 
 }  // namespace
 }  // namespace rtcost::octree

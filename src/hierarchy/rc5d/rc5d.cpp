@@ -289,7 +289,12 @@ const Registration reg{
          o.lazy = p.choice("build", {"lazy", "eager"}) == "lazy";
          o.max_bytes = static_cast<std::uint64_t>(p.integer("max_bytes", 1, 1LL << 36));
          return std::make_unique<Rc5d>(s, o);
-     }}};
+     }},
+    {{{}, kTestHits},
+     {{"max_prims=2", "max_depth=45"}, kTestHits},
+     {{"build=eager", "max_depth=10"}, kTestHits | kTestSampled},
+     {{"build=eager", "max_depth=8"}, kTestSpdModel},
+     {{"build=eager", "max_depth=12"}, kTestModelTree}}};
 
 }  // namespace
 }  // namespace rtcost::rc5d
