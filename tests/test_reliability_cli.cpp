@@ -115,6 +115,20 @@ TEST(ReliabilityCli, PlyAndOffCountsAndIndicesAreChecked) {
                      "no 'end_header' line");
     EXPECT_EQ(rtcost("info -q " + file("caps-ok.ply", "Ply" + ply(3, verts + "3 0 1 2\n").substr(3)).string()).code, 0);
     EXPECT_BAD_INPUT(rtcost("info " + file("nomagic.ply", "hello\n").string()), "does not begin with 'ply'");
+    // CI's fuzz run found assimp spinning (over 120 s) on a header with garbled keywords
+    // ("propr", "ppropery lis 0 0") whose `end_header` ends the file without a line end.
+    const std::string garbled = "ply\nformat ascii 1.0\nelement vertex 3\npropr teyfloat \x82\n"
+                                "pr$peorace 1\nppropery lis 0 0\n0 1 0\n3 0 1 2\nend_header";
+    EXPECT_BAD_INPUT(rtcost("info " + file("garbled.ply", garbled).string(), 30), "garbled.ply: PLY: the file ends at 'end_header'");
+    // With the line end, assimp reads it (and finds no faces); bare text lines are skipped.
+    CliResult r = rtcost("info " + file("garbled-nl.ply", garbled + "\n").string(), 30);
+    EXPECT_EQ(r.code, 2);
+    EXPECT_FALSE(has(r.err, "PLY:")) << r.err;
+    EXPECT_BAD_INPUT(rtcost("info " + file("arity.ply", "ply\nformat ascii 1.0\nelement vertex 3 4\nend_header\n").string()),
+                     "arity.ply:3: PLY: expected 'element NAME COUNT'");
+    EXPECT_BAD_INPUT(rtcost("info " + file("noformat.ply", "ply\nelement vertex 0\nend_header\n").string()), "no 'format' line");
+    EXPECT_BAD_INPUT(rtcost("info " + file("magic.ply", "ply junk\nformat ascii 1.0\nend_header\n").string()),
+                     "magic.ply:1: PLY: the first line must be 'ply' alone");
     // Its fourth: "BINARY" anywhere on the first line let the file through to assimp unchecked.
     EXPECT_BAD_INPUT(rtcost("info " + file("bin-glued.off", "OFF111777777770 0111BINARY11 0\n").string()),
                      "bad vertex and face counts");

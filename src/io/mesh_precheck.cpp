@@ -55,6 +55,7 @@ public:
         while (pos_ < s_.size() && s_[pos_] != '\n') ++pos_;
     }
     int line() const { return line_; }
+    bool at_end() const { return pos_ >= s_.size(); }
 
 private:
     std::string_view s_;
@@ -103,7 +104,10 @@ void check_ply(const std::string& path, const std::string& bytes) {
         std::string_view l(bytes.data() + p, (nl == std::string::npos ? bytes.size() : nl) - p);
         while (!l.empty() && (l.back() == '\r' || l.back() == ' ')) l.remove_suffix(1);
         if (l == "end_header") {
-            end = nl == std::string::npos ? bytes.size() : nl + 1;
+            // Assimp spins forever on some headers whose `end_header` ends the file without a
+            // line end (found by fuzzing); a file that ends there has no data anyway.
+            if (nl == std::string::npos) fail(0, "the file ends at 'end_header': no line end and no data after it");
+            end = nl + 1;
             break;
         }
         if (nl == std::string::npos) break;
@@ -111,48 +115,69 @@ void check_ply(const std::string& path, const std::string& bytes) {
     }
     if (end == std::string::npos) fail(0, "the header has no 'end_header' line");
 
+    // The header, line by line: the lines PLY defines must have their exact arity; other lines
+    // (some exporters write bare text such as "Created by ...") are skipped, as assimp does.
     std::vector<PlyElement> elements;
     std::string format;
-    Words w(std::string_view(bytes).substr(0, end), 0, 1);
-    for (std::string_view t = w.next(); !t.empty(); t = w.next()) {
-        const int line = w.line();
-        if (t == "comment" || t == "obj_info" || w.line() == 1) {
-            if (t == "comment" || t == "obj_info") w.skip_line();  // line 1: the magic, 'ply' in any case
-        } else if (t == "format") {
-            format = std::string(w.next());
-            w.skip_line();
-        } else if (t == "element") {
-            PlyElement e;
-            e.name = std::string(w.next());
-            if (!to_int(w.next(), e.count) || e.count < 0) fail(line, fmt::format("bad count for element '{}'", shown(e.name)));
-            elements.push_back(std::move(e));
-        } else if (t == "property") {
-            if (elements.empty()) fail(line, "property before any element");
-            PlyProperty p;
-            std::string_view type = w.next();
-            if (type == "list") {
-                bool f = false;
-                p.count_size = ply_type_size(w.next(), f);
-                p.size = ply_type_size(w.next(), p.is_float);
-                std::string_view name = w.next();
-                p.index = elements.back().name == "face" && (name == "vertex_indices" || name == "vertex_index");
-                if (p.count_size == 0 || p.size == 0 || f) fail(line, "bad list property types");
-            } else {
-                p.size = ply_type_size(type, p.is_float);
-                w.next();
-                if (p.size == 0) fail(line, fmt::format("unknown property type '{}'", shown(type)));
-            }
-            elements.back().props.push_back(p);
-        } else if (t == "end_header") {
+    int line = 0, data_line = 0;
+    for (std::size_t p = 0; p < end;) {
+        std::size_t nl = std::min(bytes.find('\n', p), end);
+        std::string_view l(bytes.data() + p, nl - p);
+        p = nl + 1;
+        ++line;
+        std::vector<std::string_view> t;
+        for (Words w(l, 0, line); !w.at_end();) {
+            std::string_view x = w.next();
+            if (!x.empty()) t.push_back(x);
+        }
+        if (line == 1) {  // the magic, 'ply' in any case, alone on its line
+            if (t.size() != 1) fail(line, "the first line must be 'ply' alone");
+            continue;
+        }
+        if (t.empty()) continue;
+        const std::string_view key = t[0];
+        if (key == "comment" || key == "obj_info") continue;
+        if (key == "end_header") {
+            if (t.size() != 1) fail(line, "'end_header' must be alone on its line");
+            data_line = line + 1;
             break;
         }
+        if (key == "format") {
+            if (t.size() != 3 || !format.empty()) fail(line, "expected one 'format FORMAT VERSION' line");
+            format = std::string(t[1]);
+            if (format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian")
+                fail(line, fmt::format("unknown format '{}'", shown(format)));
+        } else if (key == "element") {
+            PlyElement e;
+            if (t.size() != 3) fail(line, "expected 'element NAME COUNT'");
+            e.name = std::string(t[1]);
+            if (!to_int(t[2], e.count) || e.count < 0) fail(line, fmt::format("bad count for element '{}'", shown(e.name)));
+            elements.push_back(std::move(e));
+        } else if (key == "property") {
+            if (elements.empty()) fail(line, "property before any element");
+            PlyProperty pr;
+            if (t.size() == 5 && t[1] == "list") {
+                bool f = false;
+                pr.count_size = ply_type_size(t[2], f);
+                pr.size = ply_type_size(t[3], pr.is_float);
+                pr.index = elements.back().name == "face" && (t[4] == "vertex_indices" || t[4] == "vertex_index");
+                if (pr.count_size == 0 || pr.size == 0 || f) fail(line, "bad list property types");
+            } else if (t.size() == 3) {
+                pr.size = ply_type_size(t[1], pr.is_float);
+                if (pr.size == 0) fail(line, fmt::format("unknown property type '{}'", shown(t[1])));
+            } else {
+                fail(line, "expected 'property TYPE NAME' or 'property list TYPE TYPE NAME'");
+            }
+            elements.back().props.push_back(pr);
+        }
     }
+    if (format.empty()) fail(0, "the header has no 'format' line");
     long long vertices = 0;
     for (const auto& e : elements)
         if (e.name == "vertex") vertices = e.count;
 
     if (format == "ascii") {
-        Words d(bytes, end, w.line() + 1);
+        Words d(bytes, end, data_line);
         for (const auto& e : elements) {
             for (long long i = 0; i < e.count; ++i) {
                 for (const PlyProperty& p : e.props) {
@@ -175,7 +200,6 @@ void check_ply(const std::string& path, const std::string& bytes) {
         return;
     }
     const bool little = format == "binary_little_endian";
-    if (!little && format != "binary_big_endian") fail(0, fmt::format("unknown format '{}'", shown(format)));
     std::size_t pos = end;
     auto read_uint = [&](int size, long long& out) {
         if (pos + size > bytes.size()) return false;
