@@ -387,6 +387,25 @@ TEST(MeshModels, PlyAsciiAndBinary) {
     EXPECT_EQ(read_mesh(kModels + "PLY/cube_binary.ply").size(), 12u);
 }
 
+TEST(MeshModels, PolygonsAreSplitInsideThemselves) {
+    // A dart: a quad whose fourth corner is reflex, area 1.5. Split from its reflex corner its
+    // two triangles cover it exactly (0.75 each); a fan from the first corner would cover 2.5,
+    // outside the quad. A convex pentagon (area 3) is a fan of three.
+    auto area = [](const Triangle& t) { return 0.5 * length(cross(t.v1 - t.v0, t.v2 - t.v0)); };
+    Scene dart = read_mesh(write_file("dart.off", "OFF\n4 1 0\n0 0 0\n2 1 0\n0 2 0\n0.5 1 0\n4 0 1 2 3\n"));
+    ASSERT_EQ(dart.triangles.size(), 2u);
+    EXPECT_DOUBLE_EQ(area(dart.triangles[0]), 0.75);
+    EXPECT_DOUBLE_EQ(area(dart.triangles[1]), 0.75);
+    Scene penta = read_mesh(write_file("penta.ply", "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\n"
+                                                    "property float y\nproperty float z\nelement face 1\n"
+                                                    "property list uchar int vertex_indices\nend_header\n"
+                                                    "0 0 0\n2 0 0\n2 1 0\n1 2 0\n0 1 0\n5 0 1 2 3 4\n"));
+    ASSERT_EQ(penta.triangles.size(), 3u);
+    double sum = 0;
+    for (const Triangle& t : penta.triangles) sum += area(t);
+    EXPECT_DOUBLE_EQ(sum, 3.0);
+}
+
 TEST(MeshModels, StlAsciiAndBinary) {
     REQUIRE_MODEL("STL/Spider_binary.stl");
     EXPECT_EQ(read_mesh(kModels + "STL/Spider_binary.stl").size() + 56u, 1368u);

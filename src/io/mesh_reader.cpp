@@ -1,4 +1,5 @@
-// Mesh files (OBJ, PLY, STL, glTF, ...) through assimp, as triangles.
+// Mesh files as triangles: PLY and OFF through rtcost's own reader (polygon_mesh_reader.cpp
+// says why), the others (OBJ, STL, glTF, ...) through assimp.
 
 #include <algorithm>
 #include <cmath>
@@ -10,7 +11,7 @@
 #include <assimp/scene.h>
 #include <fmt/format.h>
 
-#include "mesh_precheck.hpp"
+#include "polygon_mesh_reader.hpp"
 #include "rtcost/io.hpp"
 
 namespace rtcost {
@@ -50,6 +51,55 @@ std::string face_using(const aiMesh* mesh, unsigned v) {
     return "";
 }
 
+/// The polygon's corner that a fan of triangles starts from: a reflex corner if it has one
+/// (so that a quad with one reflex corner, the only way a quad can be non-convex, is split
+/// inside itself), else the first. Polygons with more reflex corners are split as fans from it.
+std::size_t fan_corner(const std::vector<Vec3>& v, const std::uint32_t* idx, std::size_t n) {
+    if (n < 4) return 0;
+    Vec3 normal{0, 0, 0};  // Newell's normal of the polygon
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 a = v[idx[i]], b = v[idx[(i + 1) % n]];
+        normal = normal + Vec3{(a.y - b.y) * (a.z + b.z), (a.z - b.z) * (a.x + b.x), (a.x - b.x) * (a.y + b.y)};
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        const Vec3 prev = v[idx[(i + n - 1) % n]], here = v[idx[i]], next = v[idx[(i + 1) % n]];
+        if (dot(cross(here - prev, next - here), normal) < 0) return i;
+    }
+    return 0;
+}
+
+Scene scene_from_polygons(const std::string& path, const PolygonMesh& mesh) {
+    Scene scene;
+    scene.name = path;
+    scene.materials.push_back(Material{});
+    std::size_t not_triangles = 0, degenerate = 0, at = 0;
+    for (const std::uint32_t n : mesh.face_sizes) {
+        const std::uint32_t* idx = mesh.indices.data() + at;
+        at += n;
+        if (n < 3) {
+            ++not_triangles;
+            continue;
+        }
+        const std::size_t c = fan_corner(mesh.vertices, idx, n);
+        for (std::size_t k = 1; k + 1 < n; ++k) {
+            const Triangle t{mesh.vertices[idx[c]], mesh.vertices[idx[(c + k) % n]], mesh.vertices[idx[(c + k + 1) % n]]};
+            if (zero_area(t.v0, t.v1, t.v2)) {
+                ++degenerate;
+                continue;
+            }
+            scene.add(t, 0);
+        }
+    }
+    if (not_triangles > 0)
+        scene.warnings.push_back(fmt::format("{}: {} point or line faces skipped (not triangles)", path, not_triangles));
+    if (degenerate > 0)
+        scene.warnings.push_back(fmt::format("{}: {} degenerate triangles skipped (zero area)", path, degenerate));
+    if (scene.empty()) throw InputError(path, 0, no_primitives_message(scene.warnings));
+    scene.has_camera = false;  // finalize() frames the bounds
+    scene.finalize();
+    return scene;
+}
+
 }  // namespace
 
 Scene read_mesh(const std::string& path) {
@@ -57,7 +107,7 @@ Scene read_mesh(const std::string& path) {
     if (!std::filesystem::exists(path, ec)) throw InputError(path, 0, "no such file");
     if (std::filesystem::is_directory(path, ec)) throw InputError(path, 0, "is a directory");
 
-    precheck_mesh(path);
+    if (is_polygon_mesh_file(path)) return scene_from_polygons(path, read_polygon_mesh(path));
     Assimp::Importer importer;
     const aiScene* in = importer.ReadFile(path, aiProcess_ValidateDataStructure);
     if (!in) {
