@@ -6,10 +6,7 @@
 # 36000. New corpus entries stay in build-asan/corpus/ (copy small interesting ones into
 # fuzz/corpus/ by hand). FUZZ_SEED=N fixes libFuzzer's seed: the same inputs in the same order
 # on every machine (CI uses it, so that its result does not depend on the draw; long runs draw
-# a new seed each time to explore further). FUZZ_RUNS="nff=N mesh=N ..." runs each named harness
-# for exactly N inputs (SECONDS x 2 is then only a cap) from the committed corpus alone: with
-# FUZZ_SEED the run is the same sequence of inputs on every machine, so a run that passes here
-# passes in CI (a cap reached early can only shorten the sequence).
+# a new seed each time to explore further).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 seconds="${1:-60}"
@@ -31,19 +28,11 @@ status=0
 export ASAN_OPTIONS="detect_leaks=0:allocator_may_return_null=1"
 export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
 for f in $fuzzers; do
-  runs=""
-  for r in ${FUZZ_RUNS:-}; do [ "${r%%=*}" = "$f" ] && runs="${r#*=}"; done
-  if [ -n "$runs" ]; then  # a fresh output corpus: the run starts from the committed one only
-    out="$b/corpus-runs/$f"; rm -rf "$out"; limit="-runs=$runs -max_total_time=$((seconds * 2))"
-    echo "fuzz: $f for $runs inputs (at most $((seconds * 2))s)"
-  else
-    out="$b/corpus/$f"; limit="-max_total_time=$seconds"
-    echo "fuzz: $f for ${seconds}s"
-  fi
-  mkdir -p "$out"
-  if ! $b/fuzz/fuzz_$f ${FUZZ_SEED:+-seed=$FUZZ_SEED} $limit -timeout=120 -rss_limit_mb=3072 -max_len=4096 \
+  mkdir -p "$b/corpus/$f"
+  echo "fuzz: $f for ${seconds}s"
+  if ! $b/fuzz/fuzz_$f ${FUZZ_SEED:+-seed=$FUZZ_SEED} -max_total_time="$seconds" -timeout=120 -rss_limit_mb=3072 -max_len=4096 \
       -artifact_prefix="$b/findings/$f-" -print_final_stats=1 \
-      "$out" "fuzz/corpus/$f" 2> "$b/fuzz-$f.log"; then
+      "$b/corpus/$f" "fuzz/corpus/$f" 2> "$b/fuzz-$f.log"; then
     echo "fuzz: $f FOUND a problem ($b/fuzz-$f.log, $b/findings/)"; tail -40 "$b/fuzz-$f.log"
     status=1
   fi
