@@ -1,6 +1,7 @@
 // `rtcost render`: the Whitted render whose rays `--rays spd` counts, shaded and written as PNG,
 // or (`--heatmap KIND`) a per-pixel cost heat map of the chosen hierarchy.
 #include <chrono>
+#include <cmath>
 #include <iostream>
 
 #include "cli.hpp"
@@ -25,6 +26,20 @@ struct RenderArgs {
     bool log = false;
 };
 
+// Pearson's correlation of two maps, pixel by pixel (0 when either is constant).
+double pearson(const std::vector<double>& x, const std::vector<double>& y) {
+    const double n = static_cast<double>(x.size());
+    double mx = 0, my = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) mx += x[i] / n, my += y[i] / n;
+    double sxy = 0, sxx = 0, syy = 0;
+    for (std::size_t i = 0; i < x.size(); ++i) {
+        sxy += (x[i] - mx) * (y[i] - my);
+        sxx += (x[i] - mx) * (x[i] - mx);
+        syy += (y[i] - my) * (y[i] - my);
+    }
+    return sxx > 0 && syy > 0 ? sxy / std::sqrt(sxx * syy) : 0.0;
+}
+
 int cmd_heatmap(const RenderArgs& a, const Common& common, const Scene& scene, const Hierarchy& h,
                 const RenderOptions& size) {
     const HeatKind kind = parse_heat_kind(a.heatmap);
@@ -36,6 +51,7 @@ int cmd_heatmap(const RenderArgs& a, const Common& common, const Scene& scene, c
     opt.max_depth = a.depth;
     opt.time = kind == HeatKind::Time;
     opt.threads = a.threads;
+    if (kind == HeatKind::Predicted) opt.predict = predicted_ray_cost(h, opt);
     PixelCosts pc;
     {
         Progress progress(fmt::format("heat map {}", h.name()), static_cast<std::size_t>(opt.height),
@@ -53,12 +69,24 @@ int cmd_heatmap(const RenderArgs& a, const Common& common, const Scene& scene, c
     const std::string png = encode_png(draw_heatmap(values, pc.width, pc.height, style));
     write_file_atomic(a.out, png);
     const HeatSummary s = summarize(values, a.scale_max);
+    // A predicted map is shown against the measured operations of the same pixels.
+    json against;
+    std::string against_text;
+    if (kind == HeatKind::Predicted) {
+        const std::vector<double> measured = heat_values(pc, HeatKind::Ops, costs);
+        const double m = summarize(measured, 0).mean;
+        const double r = pearson(values, measured);
+        against = {{"measured_mean", m}, {"error", m > 0 ? s.mean / m - 1 : 0.0}, {"pixel_correlation", r}};
+        against_text = fmt::format("measured   mean {:.6g} (the prediction {:+.1f}%); per-pixel correlation {:.3f}\n", m,
+                                   m > 0 ? 100 * (s.mean / m - 1) : 0.0, r);
+    }
     if (common.json) {
         json j = {{"scene", scene.name}, {"hierarchy", h.name()}, {"out", a.out},
                   {"width", pc.width}, {"height", pc.height}, {"rays", a.rays},
                   {"heatmap", a.heatmap}, {"units", style.units}, {"traced_rays", pc.total.rays},
                   {"min", s.min}, {"mean", s.mean}, {"max", s.max}, {"scale_max", s.scale_max},
                   {"clipped", s.clipped}, {"bytes", png.size()}};
+        if (!against.is_null()) j["against_measured"] = against;
         std::cout << j.dump(2) << "\n";
         return 0;
     }
@@ -66,6 +94,7 @@ int cmd_heatmap(const RenderArgs& a, const Common& common, const Scene& scene, c
                pc.height, pc.total.rays, opt.tree ? "Whitted trees" : "camera rays");
     fmt::print("values     min {:.6g}  mean {:.6g}  max {:.6g} {}; scale 0 to {:.6g}{}\n", s.min, s.mean, s.max,
                style.units, s.scale_max, s.clipped ? fmt::format(" ({} pixels above)", s.clipped) : "");
+    fmt::print("{}", against_text);
     fmt::print("written    {} ({})\n", a.out, human_bytes(png.size()));
     return 0;
 }
@@ -120,7 +149,8 @@ Subcommand setup_render(CLI::App& parent, Common& common) {
     cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
     cmd->add_option("--heatmap", a->heatmap,
                     "write a per-pixel cost heat map instead: box, plane, hop, classify, prim, steps, ops "
-                    "(all operations in unit costs, or ns with --costs), time (measured ns)");
+                    "(all operations in unit costs, or ns with --costs), time (measured ns), predicted (the model's "
+                    "operations per pixel, learned from a 2% sample of the same rays, beside the measured ones)");
     cmd->add_option("--rays", a->rays, "heat map rays: camera (each pixel's camera ray) or spd (its whole Whitted tree)")
         ->check(CLI::IsMember({"camera", "spd"}))
         ->capture_default_str();

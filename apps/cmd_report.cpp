@@ -125,7 +125,7 @@ Subcommand setup_report(CLI::App& parent, Common& common) {
     cmd->add_option("--costs", a->costs, "unit costs file (from rtcost calibrate)");
     cmd->add_option("--from-eval", a->from_eval, "take the evaluation from this `rtcost eval --json --by-depth` file "
                                                  "instead of running it");
-    cmd->add_option("--heatmap", a->heatmap, "what the heat maps show: box, plane, hop, classify, prim, steps, ops, time")
+    cmd->add_option("--heatmap", a->heatmap, "what the heat maps show: box, plane, hop, classify, prim, steps, ops, time, predicted (the model's operations per pixel, each beside the measured map)")
         ->capture_default_str();
     cmd->add_option("--heatmap-size", a->heatmap_size, "heat maps' size WxH (default: --size, else 256x256)");
     cmd->add_option("--scale-max", a->scale_max, "top of the heat maps' colour scale (default: the largest value)")

@@ -23,8 +23,11 @@ enum class HeatKind {
     Steps,                            ///< traversal steps (N_TS)
     Ops,                              ///< all operations weighted by unit costs (calibrated: ns)
     Time,                             ///< measured traversal nanoseconds
+    /// The model's predicted operations (weighted as Ops) of the pixel's rays: see
+    /// predicted_ray_cost (needs PixelCostOptions::predict).
+    Predicted,
 };
-/// "box", "plane", "hop", "classify", "prim", "steps", "ops", "time".
+/// "box", "plane", "hop", "classify", "prim", "steps", "ops", "time", "predicted".
 std::string_view heat_kind_name(HeatKind k);
 /// Parses a heat kind name; throws InputError naming `what` otherwise.
 HeatKind parse_heat_kind(std::string_view name, const std::string& what = "--heatmap");
@@ -49,6 +52,9 @@ struct PixelCostOptions {
     bool time = false;             ///< also time each pixel's rays (the fast, uncounted traversal)
     int threads = 0;               ///< 0: all cores
     std::function<void(std::size_t)> progress;  ///< rows done
+    /// The model's cost of one ray of a kind (predicted_ray_cost), summed per pixel into
+    /// PixelCosts::predicted when set.
+    std::function<CostVector(const Ray&, RayKind)> predict;
 };
 
 /// Per-pixel costs of `h` over its scene, rows top to bottom.
@@ -57,11 +63,21 @@ struct PixelCosts {
     std::vector<PixelCost> pixels;
     RayCounters total;  ///< every ray's counters summed (equals trace_rays over the same rays)
     bool timed = false;
+    std::vector<CostVector> predicted;  ///< per pixel, when PixelCostOptions::predict was set
 };
 
 /// Traces each pixel's rays through `h` with counting (and, when asked, again timed), and sums
 /// them per pixel. The rays are those of `render` (tree) or `camera_rays` (camera ray alone).
 PixelCosts pixel_costs(const Hierarchy& h, const PixelCostOptions& opt = {});
+
+/// The model's cost of single rays of `h` for the pixels `opt` describes (camera rays, or
+/// Whitted trees): for each ray kind a RayCostModel learned from a sample of `sample_rays` rays
+/// (0: 2% of the pixels' rays, 256 to 4,096) of the same distribution (`camera`, or `spd` at
+/// the same size), drawn with bvh-sah as the reference. The hierarchy's model tree is read
+/// once; the rays predicted are never traced through `h` for it. Throws InputError for a
+/// hierarchy without a model tree, or rc5d (5D trees have no per-ray prediction).
+std::function<CostVector(const Ray&, RayKind)> predicted_ray_cost(const Hierarchy& h, const PixelCostOptions& opt,
+                                                                  std::size_t sample_rays = 0);
 
 /// One value per pixel for `kind` (Ops: `costs.scalar` summed over the pixel's rays). Throws
 /// InputError for Time when `pc` was not timed.

@@ -8,6 +8,7 @@
 /// the sum over nodes of pi(N) times the operations a visit of N performs.
 
 #include <array>
+#include <memory>
 #include <span>
 #include <string>
 #include <vector>
@@ -126,5 +127,25 @@ struct RaySample;
 /// traced with opt.query). Throws InputError for a sample of another scene.
 Prediction predict_segments(const ModelTree& tree, const Scene& scene, const RaySample& sample,
                             std::span<const std::uint32_t> rays, const ModelOptions& opt, const UnitCosts& costs = {});
+
+/// The model's cost of single rays (per-pixel predicted heat maps): each ray's own geometry
+/// says which nodes its segment meets and in which order, as the traversal would; whether the
+/// search has ended before a node is reached is the model's probability, learned from a ray
+/// sample's ended segments as predict_segments learns it, never from the ray's own hit. The
+/// expectation over the sample's rays is close to predict_segments's. Not for 5D trees.
+class RayCostModel {
+public:
+    /// Learns from the sample's rays `rays` (indices; e.g. those of one kind, traced with
+    /// opt.query). Keeps `tree`; `scene` must outlive the model. Throws InputError for a tree
+    /// without nodes or a 5D one.
+    RayCostModel(ModelTree tree, const Scene& scene, const RaySample& sample, std::span<const std::uint32_t> rays,
+                 const ModelOptions& opt);
+    /// The expected operations of `ray` (with opt.query's termination).
+    CostVector predict(const Ray& ray) const;
+
+private:
+    struct Impl;
+    std::shared_ptr<const Impl> impl_;
+};
 
 }  // namespace rtcost

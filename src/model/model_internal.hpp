@@ -8,6 +8,10 @@
 
 #include "rtcost/model.hpp"
 
+namespace rtcost {
+struct RaySample;
+}
+
 namespace rtcost::model {
 
 /// The cost vector's scalar fields (its `prim` array aside), for sums field by field.
@@ -50,6 +54,11 @@ struct NodeProbabilities {
     bool split = false;  ///< alpha, beta, gamma hold for this two-child node
 };
 static_assert(sizeof(NodeProbabilities) == 56);
+
+/// The segments estimator's per-node probabilities from the sample's rays `rays` (indices),
+/// before the recursion (what predict_segments feeds it). Throws InputError for a 5D tree.
+std::vector<NodeProbabilities> segment_probabilities(const ModelTree& t, const Scene& scene, const RaySample& sample,
+                                                     std::span<const std::uint32_t> rays, const ModelOptions& opt);
 
 /// Each node's parent and traversal depth (the number of its ancestors that are steps), for the
 /// sampled estimator's recursion over a materialised tree.

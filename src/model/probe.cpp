@@ -257,16 +257,13 @@ using namespace model;
 
 namespace {
 
-/// Either estimator: probe `rays` (through `oracle`), turn the tallies into the recursion's
-/// coefficients, predict.
-Prediction predict_probed(const ModelTree& t, const Scene& scene, std::span<const Ray> rays, PrimOracle& oracle,
-                          const ModelOptions& opt, const UnitCosts& costs) {
-    if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
-    Walk w(t);
-    if (t.one_path) return predict_one_path(t, w, scene, rays, oracle, opt, costs);
+/// Probes `rays` (through `oracle`) and turns the tallies into the recursion's coefficients;
+/// `met` counts the rays that meet the root. Not for 5D trees (predict_one_path).
+std::vector<NodeProbabilities> probe_probabilities(const ModelTree& t, const Scene& scene, std::span<const Ray> rays,
+                                                   PrimOracle& oracle, const ModelOptions& opt, std::size_t& met) {
     const std::size_t n = t.nodes.size();
     Probe probe(t, scene, oracle, opt.query);
-    std::size_t met = 0;
+    met = 0;
     for (std::size_t r = 0; r < rays.size(); ++r) {
         oracle.begin(r);
         met += probe.run(rays[r]);
@@ -300,6 +297,18 @@ Prediction predict_probed(const ModelTree& t, const Scene& scene, std::span<cons
                 prob[m.first + k].entered = ty.gated > 0 ? tally[m.first + k].handed / ty.gated : 0.0;
         }
     }
+    return prob;
+}
+
+/// Either estimator: probe `rays` (through `oracle`), turn the tallies into the recursion's
+/// coefficients, predict.
+Prediction predict_probed(const ModelTree& t, const Scene& scene, std::span<const Ray> rays, PrimOracle& oracle,
+                          const ModelOptions& opt, const UnitCosts& costs) {
+    if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
+    Walk w(t);
+    if (t.one_path) return predict_one_path(t, w, scene, rays, oracle, opt, costs);
+    std::size_t met = 0;
+    const std::vector<NodeProbabilities> prob = probe_probabilities(t, scene, rays, oracle, opt, met);
     Prediction p = recurse(t, w, prob, scene, opt, costs);
     scale_to_share(p, t, rays.empty() ? 0.0 : static_cast<double>(met) / rays.size(), costs);
     return p;
@@ -316,6 +325,20 @@ Prediction predict_sampled(const ModelTree& t, const Scene& scene, std::span<con
              " training rays with real primitive tests" + (t.one_path ? " (5D: " + p.note + ")" : "");
     return p;
 }
+
+namespace model {
+std::vector<NodeProbabilities> segment_probabilities(const ModelTree& t, const Scene& scene, const RaySample& sample,
+                                                     std::span<const std::uint32_t> rays, const ModelOptions& opt) {
+    if (t.nodes.empty()) throw InputError("model", 0, "this hierarchy has no model tree");
+    if (t.one_path) throw InputError("model", 0, "5D ray classification has no per-ray prediction");
+    std::vector<Ray> subset;
+    subset.reserve(rays.size());
+    for (std::uint32_t i : rays) subset.push_back(sample.rays.rays.at(i));
+    PrimOracle known(scene, sample, rays);
+    std::size_t met = 0;
+    return probe_probabilities(t, scene, subset, known, opt, met);
+}
+}  // namespace model
 
 Prediction predict_segments(const ModelTree& t, const Scene& scene, const RaySample& sample,
                             std::span<const std::uint32_t> rays, const ModelOptions& opt, const UnitCosts& costs) {

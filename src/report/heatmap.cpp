@@ -16,7 +16,7 @@
 namespace rtcost {
 namespace {
 
-constexpr std::string_view kNames[] = {"box", "plane", "hop", "classify", "prim", "steps", "ops", "time"};
+constexpr std::string_view kNames[] = {"box", "plane", "hop", "classify", "prim", "steps", "ops", "time", "predicted"};
 
 using Clock = std::chrono::steady_clock;
 
@@ -45,7 +45,7 @@ HeatKind parse_heat_kind(std::string_view name, const std::string& what) {
     for (int k = 0; k < static_cast<int>(std::size(kNames)); ++k)
         if (kNames[k] == name) return static_cast<HeatKind>(k);
     throw InputError(what, 0,
-                     fmt::format("unknown heat map kind '{}' (box, plane, hop, classify, prim, steps, ops, time)", name));
+                     fmt::format("unknown heat map kind '{}' (box, plane, hop, classify, prim, steps, ops, time, predicted)", name));
 }
 
 PixelCosts pixel_costs(const Hierarchy& h, const PixelCostOptions& opt) {
@@ -59,6 +59,7 @@ PixelCosts pixel_costs(const Hierarchy& h, const PixelCostOptions& opt) {
     pc.height = opt.height;
     pc.timed = opt.time;
     pc.pixels.resize(eye.size());
+    if (opt.predict) pc.predicted.resize(eye.size());
     std::vector<RayCounters> rows(static_cast<std::size_t>(opt.height));
     auto occluded = [&](RayKind k) {
         return is_occlusion(k) && opt.occlusion == Query::Any;
@@ -92,6 +93,9 @@ PixelCosts pixel_costs(const Hierarchy& h, const PixelCostOptions& opt) {
                 p.steps = narrow(c.steps);
                 for (int k = 0; k < kPrimKinds; ++k) p.prim[k] = narrow(c.prim[k]);
                 rows[j] += c;
+                if (opt.predict)
+                    for (std::size_t r = 0; r < rec.rays.size(); ++r)
+                        add_scaled(pc.predicted[pixel], opt.predict(rec.rays[r], rec.kinds[r]), 1.0);
                 if (!opt.time) continue;
                 // The fast path, as `trace` times it; the rays were just traced, so they are warm.
                 // The lesser of two timings: an interruption inflates one, rarely both.
@@ -115,6 +119,8 @@ PixelCosts pixel_costs(const Hierarchy& h, const PixelCostOptions& opt) {
 
 std::vector<double> heat_values(const PixelCosts& pc, HeatKind kind, const UnitCosts& costs) {
     if (kind == HeatKind::Time && !pc.timed) throw InputError("--heatmap", 0, "time: the pixels were not timed");
+    if (kind == HeatKind::Predicted && pc.predicted.size() != pc.pixels.size())
+        throw InputError("--heatmap", 0, "predicted: the pixels were not predicted");
     std::vector<double> out(pc.pixels.size());
     for (std::size_t i = 0; i < out.size(); ++i) {
         const PixelCost& p = pc.pixels[i];
@@ -127,6 +133,14 @@ std::vector<double> heat_values(const PixelCosts& pc, HeatKind kind, const UnitC
             case HeatKind::Prim: out[i] = prims; break;
             case HeatKind::Steps: out[i] = p.steps; break;
             case HeatKind::Time: out[i] = p.ns; break;
+            case HeatKind::Predicted: {
+                const CostVector& c = pc.predicted[i];
+                double s = costs.per_ray * p.rays + costs.box * c.box + costs.plane * c.plane + costs.hop * c.hop +
+                           costs.classify * c.classify;
+                for (int k = 0; k < kPrimKinds; ++k) s += costs.prim[k] * c.prim[k];
+                out[i] = s;
+                break;
+            }
             case HeatKind::Ops: {
                 // UnitCosts::scalar of the summed operations plus the fixed cost of every ray.
                 double s = costs.per_ray * p.rays + costs.box * p.box + costs.plane * p.plane + costs.hop * p.hop +
@@ -151,6 +165,9 @@ std::string heat_units(HeatKind kind, const UnitCosts& costs) {
         case HeatKind::Ops:
             return costs.calibrated ? "ns per pixel (operations x calibrated costs)" : "operations per pixel (unit costs)";
         case HeatKind::Time: return "ns per pixel (measured)";
+        case HeatKind::Predicted:
+            return costs.calibrated ? "ns per pixel (predicted operations x calibrated costs)"
+                                    : "operations per pixel (predicted by the model, unit costs)";
     }
     return "";
 }

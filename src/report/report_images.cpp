@@ -45,10 +45,23 @@ void add_heatmaps(ReportInput& in, const Scene& scene, const std::vector<std::st
         po.tree = opt.tree;
         po.time = opt.kind == HeatKind::Time;
         po.threads = opt.threads;
+        if (opt.kind == HeatKind::Predicted) {
+            // Predicted beside measured, for the hierarchies the model follows ray by ray.
+            try {
+                po.predict = predicted_ray_cost(*h, po);
+            } catch (const InputError&) {
+                continue;  // no model tree, or a 5D one
+            }
+        }
         PixelCosts pc = pixel_costs(*h, po);
-        Map m{label, heat_values(pc, opt.kind, opt.costs), {}};
+        Map m{label + ": " + std::string(heat_kind_name(opt.kind)), heat_values(pc, opt.kind, opt.costs), {}};
         m.summary = summarize(m.values, 0);
         maps.push_back(std::move(m));
+        if (opt.kind == HeatKind::Predicted) {
+            Map measured{label + ": ops (measured)", heat_values(pc, HeatKind::Ops, opt.costs), {}};
+            measured.summary = summarize(measured.values, 0);
+            maps.push_back(std::move(measured));
+        }
     }
     double top = opt.scale_max;
     if (!(top > 0))
@@ -58,12 +71,12 @@ void add_heatmaps(ReportInput& in, const Scene& scene, const std::vector<std::st
     nlohmann::json list = nlohmann::json::array();
     for (const Map& m : maps) {
         HeatStyle style;
-        style.title = fmt::format("{}: {}", m.label, heat_kind_name(opt.kind));
+        style.title = m.label;
         style.units = units;
         style.scale_max = top;
         style.log = opt.log;
         in.heatmaps.push_back({style.title, encode_png(draw_heatmap(m.values, opt.width, opt.height, style))});
-        list.push_back({{"hierarchy", m.label}, {"min", m.summary.min}, {"mean", m.summary.mean}, {"max", m.summary.max}});
+        list.push_back({{"hierarchy", m.label.substr(0, m.label.rfind(": "))}, {"map", m.label}, {"min", m.summary.min}, {"mean", m.summary.mean}, {"max", m.summary.max}});
     }
     in.heat = {{"kind", heat_kind_name(opt.kind)}, {"units", units}, {"rays", rays}, {"width", opt.width},
                {"height", opt.height}, {"scale_max", top}, {"log", opt.log}, {"maps", list}};
