@@ -67,16 +67,18 @@ int cmd_list(const Common& common) {
             scenes.push_back({{"name", "builtin:" + b.name},
                               {"levels", {{"min", b.min_level}, {"max", b.max_level}, {"default", b.default_level}}}});
         json dists = distribution_names();
-        std::cout << json{{"hierarchies", hs}, {"builtin_scenes", scenes}, {"distributions", dists}}.dump(2) << "\n";
+        json dist_info = json::array();
+        for (const RayDistributionInfo* d : ray_distributions())
+            dist_info.push_back({{"name", d->name}, {"description", d->description}, {"seeded_draws", d->seeded_draws}});
+        std::cout << json{{"hierarchies", hs}, {"builtin_scenes", scenes}, {"distributions", dists}, {"distribution_info", dist_info}}.dump(2) << "\n";
         return 0;
     }
     fmt::print("{}", hierarchy_help());
     fmt::print("Built-in scenes (SCENE = builtin:NAME[:level]):\n");
     for (const BuiltinInfo& b : builtin_scenes())
         fmt::print("  {:<8} levels {}..{}, default {}\n", b.name, b.min_level, b.max_level, b.default_level);
-    std::string names;
-    for (const auto& n : distribution_names()) names += (names.empty() ? "" : ", ") + n;
-    fmt::print("Ray distributions (--rays NAME, or a ray file): {}\n", names);
+    fmt::print("Ray distributions (--rays NAME, or a ray file):\n");
+    for (const RayDistributionInfo* d : ray_distributions()) fmt::print("  {:<8} {}\n", d->name, d->description);
     return 0;
 }
 

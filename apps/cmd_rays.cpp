@@ -22,15 +22,16 @@ int cmd_rays(const RaysArgs& a, const Common& common) {
     Scene scene = load(a.scene, common, a.spec.view);
     auto start = std::chrono::steady_clock::now();
     RaySet set;
-    if (is_tree_distribution(a.spec.name)) {
-        // The number of rows is known once the generator starts (it depends on --size).
+    {
+        // Distributions made by tracing report rows; the number is known once they start.
         std::optional<Progress> progress;
-        set = make_tree_rays(scene, a.spec, checked_threads(a.threads, common.quiet || common.json), [&](std::size_t done, std::size_t rows) {
+        RayMaking making;
+        making.threads = checked_threads(a.threads, common.quiet || common.json);
+        making.progress = [&](std::size_t done, std::size_t rows) {
             if (!progress) progress.emplace(fmt::format("rays {} (rows)", a.spec.name), rows, common.quiet || common.json);
             progress->update(done);
-        });
-    } else {
-        set = make_rays(scene, a.spec);
+        };
+        set = make_rays(scene, a.spec, making);
     }
     print_warnings(set.warnings, common.quiet || common.json);
     double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -191,7 +191,9 @@ int main(int argc, char** argv) {
     }
     for (const auto& s : scenes) {
         for (const auto& h : hier) {
-            for (const char* d : {"camera", "spd", "diffuse", "shadow", "aimed", "random"})
+            for (const RayDistributionInfo* dist : ray_distributions()) {
+                if (!dist->benchmarked) continue;
+                const std::string& d = dist->name;
                 for (int threads : {1, 0}) {
                     auto* b = benchmark::RegisterBenchmark(
                         ("trace/" + s + "/" + d + "/" + h + (threads == 1 ? "/1t" : "/mt")).c_str(), trace_bench, s,
@@ -201,6 +203,7 @@ int main(int argc, char** argv) {
                     // threads (which a shared machine's other load does not inflate).
                     if (threads != 1) b->UseManualTime()->MeasureProcessCPUTime();
                 }
+            }
             benchmark::RegisterBenchmark(("build/" + s + "/" + h).c_str(), build_bench, s, h)
                 ->Unit(benchmark::kMillisecond)
                 ->MinTime(0.5);

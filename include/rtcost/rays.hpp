@@ -4,6 +4,7 @@
 /// Every generator is deterministic for a given seed (same seed, same rays, on every machine).
 
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -85,11 +86,49 @@ struct RaySpec {
     ViewSpec view;                    ///< camera and lights (see apply_view; make_rays reads the scene's)
 };
 
-/// Names accepted by make_rays besides file paths.
+/// Names accepted by make_rays besides file paths: the registered distributions, in order.
 std::vector<std::string> distribution_names();
 
-/// Builds the ray set `spec` names over `scene`; throws InputError for a bad spec or file.
-RaySet make_rays(const Scene& scene, const RaySpec& spec);
+/// How long work reports itself while a distribution makes its rays.
+struct RayMaking {
+    int threads = 0;  ///< 0: all cores (distributions made by tracing)
+    std::function<void(std::size_t done, std::size_t total)> progress;  ///< rows, for those that trace
+};
+
+/// A registered ray distribution (`--rays NAME`): its name, what it is, and how it is made.
+/// Each lives in its own file under src/rays/ with a RayDistributionRegistration; the CLI,
+/// `list`, the Python module and the tests read the registry.
+struct RayDistributionInfo {
+    std::string name;
+    std::string description;
+    int order = 100;  ///< where listings put it (lower first)
+    /// Independent draws of a seeded process over the scene (`--count`, `--seed`): another seed
+    /// is a fresh sample of the same distribution, which `eval` trains the sampled estimator on.
+    bool seeded_draws = false;
+    /// In the trace benchmark (bench/): the rays that matter to a renderer, not those that
+    /// mostly miss or exist for the model's tests.
+    bool benchmarked = false;
+    std::function<RaySet(const Scene&, const RaySpec&, const RayMaking&)> make;
+};
+
+/// The registered distributions, by `order`.
+std::vector<const RayDistributionInfo*> ray_distributions();
+/// The distribution called `name`, or nullptr.
+const RayDistributionInfo* find_ray_distribution(std::string_view name);
+
+/// Registers a distribution at static-initialisation time, once in its file:
+///   static const rtcost::RayDistributionRegistration reg{{.name = "camera", .description = "...",
+///                                                        .order = 0, .benchmarked = true, .make = maker}};
+struct RayDistributionRegistration {
+    explicit RayDistributionRegistration(RayDistributionInfo info);
+};
+
+/// A set of rays all of one kind, described as `described` (for distributions' makers).
+RaySet one_kind(std::vector<Ray> rays, RayKind kind, std::string described);
+
+/// Builds the ray set `spec` names over `scene` (a registered distribution, or a ray file);
+/// throws InputError for a bad spec or file.
+RaySet make_rays(const Scene& scene, const RaySpec& spec, const RayMaking& making = {});
 
 /// Most rays one ray set may hold (--count, --size W*H): about 60 bytes each with the hits.
 inline constexpr std::uint64_t kMaxRays = 50'000'000;

@@ -361,7 +361,7 @@ EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& 
     std::string split = "none";
     std::optional<RaySample> sample = take_sample(scene, test, opt, sample_seconds, split);
     if (wants(opt, Estimator::Sampled)) {
-        if (spec.name == "lines" || spec.name == "random" || spec.name == "aimed") {
+        if (const RayDistributionInfo* d = find_ray_distribution(spec.name); d && d->seeded_draws) {
             // A fresh draw of the same distribution with another seed.
             RaySpec t = spec;
             t.seed = spec.seed + 7919;

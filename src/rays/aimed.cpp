@@ -4,6 +4,8 @@
 #include <cmath>
 #include <numbers>
 
+#include <fmt/format.h>
+
 #include "rtcost/rays.hpp"
 #include "util/rng.hpp"
 
@@ -80,5 +82,18 @@ std::vector<Ray> aimed_rays(const Scene& scene, std::size_t n, std::uint64_t see
     }
     return rays;
 }
+
+namespace {
+const RayDistributionRegistration kAimed{
+    {.name = "aimed",
+     .description = "incoherent rays that hit: from a sphere around the scene to random points of its primitives (--count, --seed)",
+     .order = 70,
+     .seeded_draws = true,
+     .benchmarked = true,
+     .make = [](const Scene& scene, const RaySpec& spec, const RayMaking&) {
+         return one_kind(aimed_rays(scene, spec.count, spec.seed), RayKind::Test,
+                         fmt::format("aimed {} seed {}", spec.count, spec.seed));
+     }}};
+}  // namespace
 
 }  // namespace rtcost

@@ -120,4 +120,36 @@ void parse_size(const std::string& text, const std::string& what, int& width, in
                                               static_cast<std::uint64_t>(width) * height, kMaxRays));
 }
 
+namespace {
+const RayDistributionRegistration kCamera{
+    {.name = "camera",
+     .description = "one eye ray per pixel centre of the scene's camera (--size WxH)",
+     .order = 0,
+     .benchmarked = true,
+     .make = [](const Scene& scene, const RaySpec& spec, const RayMaking&) {
+         int w = scene.camera.width, h = scene.camera.height;
+         if (!spec.size.empty()) parse_size(spec.size, "--size", w, h);
+         return one_kind(camera_rays(scene.camera, w, h), RayKind::Eye, fmt::format("camera {}x{}", w, h));
+     }}};
+const RayDistributionRegistration kLines{
+    {.name = "lines",
+     .description = "isotropic random lines through the scene's box (--count, --seed): the model's exact case",
+     .order = 50,
+     .seeded_draws = true,
+     .make = [](const Scene& scene, const RaySpec& spec, const RayMaking&) {
+         return one_kind(line_rays(scene.bounds(), spec.count, spec.seed), RayKind::Line,
+                         fmt::format("lines {} seed {}", spec.count, spec.seed));
+     }}};
+const RayDistributionRegistration kRandom{
+    {.name = "random",
+     .description = "rays from random points of the scene's box grown by half its size, in random directions (--count, --seed)",
+     .order = 60,
+     .seeded_draws = true,
+     .benchmarked = true,
+     .make = [](const Scene& scene, const RaySpec& spec, const RayMaking&) {
+         return one_kind(random_rays(scene.bounds(), spec.count, spec.seed), RayKind::Test,
+                         fmt::format("random {} seed {}", spec.count, spec.seed));
+     }}};
+}  // namespace
+
 }  // namespace rtcost

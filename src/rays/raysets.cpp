@@ -1,7 +1,10 @@
-// Named ray distributions: the one place that turns `--rays NAME` into rays.
+// The registry of ray distributions, and make_rays: the one place that turns `--rays NAME`
+// (or a ray file) into rays. The distributions register themselves in their own files.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <charconv>
+#include <deque>
 #include <cmath>
 #include <filesystem>
 
@@ -29,10 +32,38 @@ std::string_view ray_kind_name(RayKind k) {
 
 bool is_occlusion(RayKind kind) { return kind == RayKind::Shadow || kind == RayKind::AO; }
 
-std::vector<std::string> distribution_names() { return {"camera", "spd", "shadow", "diffuse", "ao", "lines", "random", "aimed"}; }
-
 namespace {
-RaySet uniform(std::vector<Ray> rays, RayKind kind, std::string described) {
+// Stable addresses: registrations keep pointers to their entries.
+std::deque<RayDistributionInfo>& registry() {
+    static std::deque<RayDistributionInfo> r;
+    return r;
+}
+}  // namespace
+
+RayDistributionRegistration::RayDistributionRegistration(RayDistributionInfo info) {
+    registry().push_back(std::move(info));
+}
+
+std::vector<const RayDistributionInfo*> ray_distributions() {
+    std::vector<const RayDistributionInfo*> out;
+    for (const RayDistributionInfo& d : registry()) out.push_back(&d);
+    std::stable_sort(out.begin(), out.end(), [](auto* a, auto* b) { return a->order < b->order; });
+    return out;
+}
+
+const RayDistributionInfo* find_ray_distribution(std::string_view name) {
+    for (const RayDistributionInfo& d : registry())
+        if (d.name == name) return &d;
+    return nullptr;
+}
+
+std::vector<std::string> distribution_names() {
+    std::vector<std::string> out;
+    for (const RayDistributionInfo* d : ray_distributions()) out.push_back(d->name);
+    return out;
+}
+
+RaySet one_kind(std::vector<Ray> rays, RayKind kind, std::string described) {
     RaySet set;
     set.kinds.assign(rays.size(), kind);
     set.summary.push_back({std::string(ray_kind_name(kind)), rays.size()});
@@ -40,7 +71,6 @@ RaySet uniform(std::vector<Ray> rays, RayKind kind, std::string described) {
     set.described = std::move(described);
     return set;
 }
-}  // namespace
 
 namespace {
 /// Comma-separated finite numbers, exactly `n` of them.
@@ -90,28 +120,14 @@ void apply_view(Scene& scene, const ViewSpec& view) {
     }
 }
 
-RaySet make_rays(const Scene& scene, const RaySpec& spec) {
-    if (spec.name == "camera") {
-        int w = scene.camera.width, h = scene.camera.height;
-        if (!spec.size.empty()) parse_size(spec.size, "--size", w, h);
-        return uniform(camera_rays(scene.camera, w, h), RayKind::Eye, fmt::format("camera {}x{}", w, h));
-    }
-    if (spec.name == "lines")
-        return uniform(line_rays(scene.bounds(), spec.count, spec.seed), RayKind::Line,
-                       fmt::format("lines {} seed {}", spec.count, spec.seed));
-    if (spec.name == "random")
-        return uniform(random_rays(scene.bounds(), spec.count, spec.seed), RayKind::Test,
-                       fmt::format("random {} seed {}", spec.count, spec.seed));
-    if (spec.name == "aimed")
-        return uniform(aimed_rays(scene, spec.count, spec.seed), RayKind::Test,
-                       fmt::format("aimed {} seed {}", spec.count, spec.seed));
-    if (is_tree_distribution(spec.name)) return make_tree_rays(scene, spec);
+RaySet make_rays(const Scene& scene, const RaySpec& spec, const RayMaking& making) {
+    if (const RayDistributionInfo* d = find_ray_distribution(spec.name)) return d->make(scene, spec, making);
     if (std::error_code ec; !std::filesystem::exists(spec.name, ec)) {
         std::string names;
         for (const auto& n : distribution_names()) names += (names.empty() ? "" : ", ") + n;
         throw InputError(spec.name, 0, "no such file, and not a distribution (" + names + ")");
     }
-    RaySet set = uniform(read_rays(spec.name), RayKind::File, spec.name);
+    RaySet set = one_kind(read_rays(spec.name), RayKind::File, spec.name);
     std::size_t far = 0, first = 0;
     for (std::size_t i = set.rays.size(); i-- > 0;)
         if (starts_too_far(scene.bounds(), set.rays[i])) ++far, first = i;

@@ -278,4 +278,33 @@ RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, int threads,
     return set;
 }
 
+namespace {
+RaySet make_tree(const Scene& scene, const RaySpec& spec, const RayMaking& making) {
+    return make_tree_rays(scene, spec, making.threads, making.progress);
+}
+const RayDistributionRegistration kSpd{
+    {.name = "spd",
+     .description = "the SPD Whitted ray trees of 512x512 pixel corners (or --size): eye, shadow, reflection and refraction rays",
+     .order = 10,
+     .benchmarked = true,
+     .make = make_tree}};
+const RayDistributionRegistration kShadow{
+    {.name = "shadow",
+     .description = "shadow rays from the camera rays' hits to each light (any-hit)",
+     .order = 20,
+     .benchmarked = true,
+     .make = make_tree}};
+const RayDistributionRegistration kDiffuse{
+    {.name = "diffuse",
+     .description = "one cosine-weighted diffuse bounce from each camera ray's hit (--seed)",
+     .order = 30,
+     .benchmarked = true,
+     .make = make_tree}};
+const RayDistributionRegistration kAo{
+    {.name = "ao",
+     .description = "ambient-occlusion rays from the camera rays' hits, 5% of the scene's diagonal long (any-hit, --seed)",
+     .order = 40,
+     .make = make_tree}};
+}  // namespace
+
 }  // namespace rtcost
