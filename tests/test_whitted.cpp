@@ -3,7 +3,6 @@
 // `rays` and `render` subcommands.
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
-#include <png.h>
 
 #include <cmath>
 #include <cstring>
@@ -15,6 +14,7 @@
 #include <unistd.h>
 
 #include "rtcost/whitted.hpp"
+#include "report_test_util.hpp"
 #include "test_support.hpp"
 
 namespace fs = std::filesystem;
@@ -303,24 +303,9 @@ TEST(WhittedRaySet, DiffuseIsCosineWeightedAndSeeded) {
     EXPECT_NE(std::memcmp(a.rays.data(), other.rays.data(), a.rays.size() * sizeof(Ray)), 0);
 }
 
-Image decode_png(const std::string& bytes) {
-    png_image image;
-    std::memset(&image, 0, sizeof image);
-    image.version = PNG_IMAGE_VERSION;
-    Image img;
-    if (!png_image_begin_read_from_memory(&image, bytes.data(), bytes.size())) return img;
-    image.format = PNG_FORMAT_RGB;
-    img.width = static_cast<int>(image.width);
-    img.height = static_cast<int>(image.height);
-    img.rgb.resize(PNG_IMAGE_SIZE(image));
-    if (!png_image_finish_read(&image, nullptr, img.rgb.data(), 0, nullptr)) img = Image{};
-    return img;
-}
-
-std::array<int, 3> pixel(const Image& img, int i, int j) {
-    const std::uint8_t* p = &img.rgb[(static_cast<std::size_t>(j) * img.width + i) * 3];
-    return {p[0], p[1], p[2]};
-}
+// PNG decoding and pixels: the report tests' helpers.
+using report_test::decode_png;
+using report_test::pixel;
 
 TEST(Render, SphereOverBackgroundAndPngRoundTrip) {
     Scene s = read_nff(camera("0 0 5", "0 0 0", "0 1 0", 16) + "b 0 0 1\nl 0 0 10\nf 1 0 0 1 0 0 0 1\ns 0 0 0 0.8\n",
