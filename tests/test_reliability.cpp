@@ -475,9 +475,27 @@ TEST(Reliability, RaysAreExactUpToTheResolvedDistanceAndWarnedAboutBeyondIt) {
     spec.name = far.string();
     const std::vector<std::string> w = make_rays(s, spec).warnings;
     ASSERT_EQ(w.size(), 1u);
-    EXPECT_TRUE(contains(w[0], "1 rays (the first: ray 1) start more than 100000 scene sizes away")) << w[0];
+    EXPECT_TRUE(contains(w[0], "1 rays (the first: ray 1) start more than 10000 scene sizes away")) << w[0];
     fs::remove(near);
     fs::remove(far);
+    // A later finding: a head-on ray in the octree's split plane x = 0 from 3.2e4 scene sizes
+    // (z = -776200), where float t resolves positions only to 0.08, nearly a whole cell of the
+    // octree at depth 8 (0.094): its cell walk skipped the hit. That distance is now beyond the
+    // limit; from the limit the same ray gives brute force's hit everywhere.
+    const Ray found{{0, 0.50001502f, -776200}, {0, -2.9057325e-41f, 0.65625f}, 8.8965637e-41f, kInf};
+    EXPECT_TRUE(starts_too_far(s.bounds(), found));
+    Ray at_limit = found;
+    at_limit.o.z = s.bounds().lo.z - kMaxResolvedDistance * size * 0.999f;
+    ASSERT_FALSE(starts_too_far(s.bounds(), at_limit));
+    const Hit head_on = trace_rays(*build_hierarchy(s, "brute"), std::span(&at_limit, 1), opt).hits[0];
+    ASSERT_EQ(head_on.prim, 0);
+    for (const HierarchyInfo* info : hierarchies()) {
+        if (info->name == "embree" || info->name == "brute") continue;
+        SCOPED_TRACE(info->name + " head-on");
+        const Hit got = trace_rays(*build_hierarchy(s, info->name), std::span(&at_limit, 1), opt).hits[0];
+        EXPECT_EQ(got.prim, head_on.prim);
+        EXPECT_EQ(got.t, head_on.t);
+    }
 }
 
 TEST(Reliability, ARayInAFaceOfAPrimitivesBoxMeetsItExactlyWhenItsComponentIsZero) {
