@@ -51,7 +51,9 @@ TEST(RayDistributions, EveryRegisteredOneMakesDeterministicRaysOfItsKinds) {
             ASSERT_LE(r.tmin, r.tmax);
         }
         EXPECT_TRUE(same_rays(a, make(s, d->name, 3))) << "the same seed gives the same rays";
-        if (d->seeded_draws) EXPECT_FALSE(same_rays(a, make(s, d->name, 4))) << "another seed is a fresh draw";
+        if (d->seeded_draws) {
+            EXPECT_FALSE(same_rays(a, make(s, d->name, 4))) << "another seed is a fresh draw";
+        }
     }
     // The listing follows the registry's order.
     std::vector<std::string> in_order;

@@ -182,6 +182,43 @@ TEST(ModelSegments, ReplayEqualsTheSampledProbeAndTheTraversalForEveryHierarchyA
     }
 }
 
+// The predictor over a hierarchy materialises only what the sample reaches, and predicts
+// exactly what the whole tree predicts, for every hierarchy and query; a query that runs its
+// segments past the sample's ends (every query but the sample's own) makes it fall back on the
+// whole tree.
+TEST(ModelSegments, TheReachedTreePredictsWhatTheWholeTreePredicts) {
+    Scene s = builtin_scene("balls", 3);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    const RaySample smp = draw_sample_from(s, mixed_rays(s), 200, 3, *ref);
+    std::vector<std::uint32_t> idx(smp.size());
+    for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    std::size_t pruned_trees = 0;
+    for (const auto& [name, set] : modelled_variants(s)) {
+        auto h = build_hierarchy(s, name, set);
+        const ModelTree whole = h->model_tree();
+        for (Query q : {Query::Closest, Query::Any, Query::All}) {
+            const std::string what = name + " " + ::testing::PrintToString(set) + " query " +
+                                     std::to_string(static_cast<int>(q));
+            SegmentsPredictor predictor(*h, s, smp);
+            const std::size_t reached = predictor.tree().nodes.size();
+            EXPECT_LE(reached, whole.nodes.size()) << what;
+            ModelOptions o;
+            o.query = q;
+            const Prediction a = predictor.predict(idx, o), b = predict_segments(whole, s, smp, idx, o);
+            EXPECT_DOUBLE_EQ(a.scalar, b.scalar) << what;
+            EXPECT_DOUBLE_EQ(a.cost.steps, b.cost.steps) << what;
+            EXPECT_DOUBLE_EQ(a.cost.prim_tests(), b.cost.prim_tests()) << what;
+            if (q == Query::Closest && reached < whole.nodes.size()) ++pruned_trees;
+            if (reached < whole.nodes.size() && q == Query::All && whole.cull && !whole.one_path) {
+                // The closest-hit sample's ends are not those of a search that never ends.
+                EXPECT_EQ(predictor.tree().nodes.size(), whole.nodes.size()) << what << ": fell back on the whole tree";
+            }
+        }
+    }
+    // The subdivisions of a 820-sphere scene have far more cells than 200 rays meet.
+    EXPECT_GE(pruned_trees, 5u);
+}
+
 TEST(ModelSegments, ASampleOfAnotherSceneIsRefused) {
     Scene a = builtin_scene("balls", 3), b = builtin_scene("tetra", 2);
     auto ref = build_hierarchy(a, "bvh-sah");

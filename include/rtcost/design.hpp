@@ -41,6 +41,9 @@ DesignInput draw_design_input(const Scene& scene, const Params& p);
 /// The model's cost per ray of a model tree on the sample (segments estimator, each ray with
 /// its own query), in `costs`' units.
 double sample_cost(const ModelTree& tree, const Scene& scene, const RaySample& sample, const UnitCosts& costs);
+/// The same for a hierarchy, materialising only the part of its tree the sample reaches
+/// (SegmentsPredictor): what a design search calls for every candidate it builds.
+double sample_cost(const Hierarchy& h, const Scene& scene, const RaySample& sample, const UnitCosts& costs);
 
 /// One family in `rtcost design`.
 struct DesignRow {

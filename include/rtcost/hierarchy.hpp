@@ -47,6 +47,9 @@ struct ModelNode {
     /// first carries the visit, the other two none).
     float box = 0, plane = 0, hop = 0, classify = 0;
     bool step = true;            ///< a visit is one traversal step (N_TS)
+    /// A subtree left out of a tree materialised for a ray sample (reached_model_tree): no
+    /// segment of the sample meets it, so the node stands for it as an empty leaf.
+    bool pruned = false;
     /// 5D ray classification: the node is a set of rays, `region` its origin box and these its
     /// directions: dominant axis `beam_axis` (-1: not a beam) and sign, u and v ranges (the other
     /// two direction components over |d[beam_axis]|, lower axis first). Children split one of

@@ -128,6 +128,34 @@ struct RaySample;
 Prediction predict_segments(const ModelTree& tree, const Scene& scene, const RaySample& sample,
                             std::span<const std::uint32_t> rays, const ModelOptions& opt, const UnitCosts& costs = {});
 
+/// The segments estimator over a hierarchy rather than a materialised tree. A sample reaches a
+/// small part of a large tree, and materialising the whole tree (then a tally per node) costs
+/// far more than replaying the sample: so only the subtrees that some sample segment meets, up
+/// to where the sample says it ends, are materialised (the others stand as pruned empty leaves,
+/// ModelNode::pruned). Should a replay still enter a pruned node, the whole tree is materialised
+/// and the prediction made again on it: the result is that of predict_segments on the whole
+/// tree either way.
+class SegmentsPredictor {
+public:
+    /// Materialises the part of `h`'s model tree that `sample` can reach. `h`, `scene` and
+    /// `sample` must outlive the predictor.
+    SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample);
+    /// predict_segments over the sample's rays `rays`.
+    Prediction predict(std::span<const std::uint32_t> rays, const ModelOptions& opt, const UnitCosts& costs = {});
+    /// Seconds spent materialising trees so far (the reached one, and the whole one if needed).
+    double tree_seconds() const { return tree_seconds_; }
+    /// The tree predictions are made on (pruned until a replay needed the whole one).
+    const ModelTree& tree() const { return tree_; }
+
+private:
+    const Hierarchy& h_;
+    const Scene& scene_;
+    const RaySample& sample_;
+    ModelTree tree_;
+    bool whole_ = false;
+    double tree_seconds_ = 0;
+};
+
 /// The model's cost of single rays (per-pixel predicted heat maps): each ray's own geometry
 /// says which nodes its segment meets and in which order, as the traversal would; whether the
 /// search has ended before a node is reached is the model's probability, learned from a ray

@@ -12,8 +12,8 @@ namespace rtcost::designing {
 
 inline std::unique_ptr<Hierarchy> cheaper_on_sample(std::unique_ptr<Hierarchy> designed, std::unique_ptr<Hierarchy> usual,
                                                     const Scene& s, const DesignInput& in) {
-    const double by_test = sample_cost(designed->model_tree(), s, in.sample, in.costs);
-    const double by_builder = sample_cost(usual->model_tree(), s, in.sample, in.costs);
+    const double by_test = sample_cost(*designed, s, in.sample, in.costs);
+    const double by_builder = sample_cost(*usual, s, in.sample, in.costs);
     return by_builder < by_test ? std::move(usual) : std::move(designed);
 }
 

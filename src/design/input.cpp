@@ -31,7 +31,11 @@ DesignInput draw_design_input(const Scene& scene, const Params& p) {
     return in;
 }
 
-double sample_cost(const ModelTree& tree, const Scene& scene, const RaySample& sample, const UnitCosts& costs) {
+namespace {
+
+/// The sample's mean cost per ray, each ray predicted with its own query by `predict(rays, options)`.
+template <class Predict>
+double mean_by_query(const RaySample& sample, Predict&& predict) {
     std::array<std::vector<std::uint32_t>, 3> by_query;
     for (std::uint32_t i = 0; i < sample.size(); ++i) by_query[static_cast<int>(sample.queries[i])].push_back(i);
     double sum = 0;
@@ -39,10 +43,24 @@ double sample_cost(const ModelTree& tree, const Scene& scene, const RaySample& s
         if (by_query[q].empty()) continue;
         ModelOptions o;
         o.query = static_cast<Query>(q);
-        const Prediction pr = predict_segments(tree, scene, sample, by_query[q], o, costs);
-        sum += pr.scalar * static_cast<double>(by_query[q].size());
+        sum += predict(by_query[q], o).scalar * static_cast<double>(by_query[q].size());
     }
     return sample.size() ? sum / static_cast<double>(sample.size()) : 0;
+}
+
+}  // namespace
+
+double sample_cost(const ModelTree& tree, const Scene& scene, const RaySample& sample, const UnitCosts& costs) {
+    return mean_by_query(sample, [&](std::span<const std::uint32_t> rays, const ModelOptions& o) {
+        return predict_segments(tree, scene, sample, rays, o, costs);
+    });
+}
+
+double sample_cost(const Hierarchy& h, const Scene& scene, const RaySample& sample, const UnitCosts& costs) {
+    SegmentsPredictor predictor(h, scene, sample);
+    return mean_by_query(sample, [&](std::span<const std::uint32_t> rays, const ModelOptions& o) {
+        return predictor.predict(rays, o, costs);
+    });
 }
 
 }  // namespace rtcost

@@ -260,14 +260,17 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         row.modelled = h->modelled();
         if (row.modelled) {
             if (opt.on_step) opt.on_step("model " + req.label());
-            // The sampled estimator's probe indexes a materialised tree; the geometric one reads
-            // the hierarchy where it lies.
-            const bool probed = sampled || wants(opt, Estimator::Segments);
+            // The sampled estimator's probe indexes a materialised tree; the segments one the
+            // part of it that the sample reaches; the geometric one reads the hierarchy where
+            // it lies. Materialising a tree is part of what a probed prediction costs.
             const auto tree_start = std::chrono::steady_clock::now();
-            const ModelTree tree = probed ? h->model_tree() : ModelTree{};
-            // Materialising the tree is part of what a probed prediction costs.
+            const ModelTree tree = sampled ? h->model_tree() : ModelTree{};
             const double tree_seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - tree_start).count();
+            std::optional<SegmentsPredictor> segments;
+            if (sample && wants(opt, Estimator::Segments)) segments.emplace(*h, scene, *sample);
+            // A fallback on the whole tree is timed within the prediction that needed it.
+            const double reached_seconds = segments ? segments->tree_seconds() : 0.0;
             for (Estimator est : opt.estimators) {
                 for (Preset preset : opt.presets) {
                     std::vector<std::pair<double, Prediction>> parts;
@@ -283,7 +286,7 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                         if (est == Estimator::Sampled) {
                             parts.emplace_back(share, predict_sampled(tree, scene, train_kinds[k], o, costs));
                         } else if (est == Estimator::Segments) {
-                            parts.emplace_back(share, predict_segments(tree, scene, *sample, sample_kinds[k], o, costs));
+                            parts.emplace_back(share, segments->predict(sample_kinds[k], o, costs));
                         } else {
                             auto it = geometric.find(o.query);
                             if (it == geometric.end())
@@ -294,7 +297,8 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
                     }
                     row.predictions.push_back(mix(parts, costs));
-                    if (est != Estimator::Geometric) row.predictions.back().seconds += tree_seconds;
+                    if (est == Estimator::Sampled) row.predictions.back().seconds += tree_seconds;
+                    if (est == Estimator::Segments) row.predictions.back().seconds += reached_seconds;
                 }
             }
         }

@@ -60,6 +60,10 @@ static_assert(sizeof(NodeProbabilities) == 56);
 std::vector<NodeProbabilities> segment_probabilities(const ModelTree& t, const Scene& scene, const RaySample& sample,
                                                      std::span<const std::uint32_t> rays, const ModelOptions& opt);
 
+/// Thrown by a probe that enters a node left out of a reached tree (SegmentsPredictor then
+/// predicts on the whole tree).
+struct PrunedNodeReached {};
+
 /// Each node's parent and traversal depth (the number of its ancestors that are steps), for the
 /// sampled estimator's recursion over a materialised tree.
 struct Walk {

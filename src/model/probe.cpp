@@ -178,6 +178,7 @@ private:
 
     void visit(std::uint32_t node, Segment s) {
         const ModelNode& m = t_.nodes[node];
+        if (m.pruned) throw PrunedNodeReached{};
         Tally& ty = tally_[node];
         ty.handed += 1;
         if (m.has_bv) {

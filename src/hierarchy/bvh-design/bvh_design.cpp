@@ -251,8 +251,8 @@ const Registration reg{
          auto by_sah = std::make_unique<Bvh>(s, "bvh-design", build_sah(s, usual), true);
          if (p.choice("occlusion", {"near", "sample"}) == "near")
              return designing::cheaper_on_sample(std::move(designed), std::move(by_sah), s, in);
-         if (sample_cost(by_sah->model_tree(), s, in.sample, in.costs) <
-             sample_cost(designed->model_tree(), s, in.sample, in.costs))
+         if (sample_cost(*by_sah, s, in.sample, in.costs) <
+             sample_cost(*designed, s, in.sample, in.costs))
              return by_sah;
          return std::make_unique<DesignedBvh>(s, std::move(d.data), std::move(d.right_first));
      }}};

@@ -19,7 +19,7 @@ std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, 
         double c = kInf;
         if (cells <= max_cells) {
             const Grid g(s, r, assign, mailbox);
-            c = sample_cost(g.model_tree(), s, in.sample, in.costs);
+            c = sample_cost(g, s, in.sample, in.costs);
         }
         seen[r] = c;
         return c;

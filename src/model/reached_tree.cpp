@@ -1,0 +1,181 @@
+// The part of a hierarchy's model tree that a ray sample can reach. A probe of a few thousand
+// segments reaches a small share of a large tree (an octree of 10^6 nodes), and writing out the
+// whole tree, then a tally and a probability per node, costs far more than the probe itself:
+// fresh memory is paid for page by page. So the tree is materialised as it is emitted, keeping a
+// node's subtree only when some segment of the sample meets its region.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <stdexcept>
+
+#include "model_internal.hpp"
+#include "rtcost/sample.hpp"
+
+namespace rtcost {
+
+namespace {
+
+/// A segment of one sample ray, as far as it reaches into the node being emitted.
+struct Reach {
+    std::uint32_t ray;
+    Segment s;
+};
+
+/// Materialises an emitted tree like Hierarchy::model_tree, but stands a subtree that none of
+/// the sample's segments meets by a pruned empty leaf (its nodes are read and dropped). Which
+/// segments reach a node is found the way the probe finds it: the parent's segment (clipped to
+/// the parent's bounding volume) clipped to the child's region.
+class ReachCollector final : public ModelSink {
+public:
+    ReachCollector(ModelTree& t, const RaySample& sample) : t_(t), sample_(sample) {}
+
+    bool begin(const ModelFlags& f) override {
+        static_cast<ModelFlags&>(t_) = f;
+        // 5D trees classify rays instead of clipping them: kept whole.
+        whole_ = f.one_path;
+        const std::size_t n = sample_.size();
+        inv_.reserve(n);
+        ends_.resize(n);
+        for (std::size_t i = 0; i < n; ++i) {
+            const Ray& r = sample_.rays.rays[i];
+            inv_.emplace_back(r);
+            // How far the probe can follow the ray. A closest-hit search with culling visits no
+            // region that starts at or beyond its hit, and cannot pass the nearest crossing,
+            // t_end, without having found it in a region that holds it; an any-hit search ends
+            // at whichever occluder it finds first, and one that visits everything never ends.
+            // A margin covers rounding; a replay that still reaches a pruned node falls back on
+            // the whole tree (predict_segments throws).
+            const bool closest = sample_.queries[i] == Query::Closest && f.cull;
+            float end = r.tmax;
+            if (closest && sample_.t_end[i] < r.tmax)
+                end = std::min(r.tmax, sample_.t_end[i] + 1e-4f * std::fabs(sample_.t_end[i]) + 1e-6f);
+            ends_[i] = end;
+        }
+        return true;
+    }
+
+    void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
+        if (skip_ > 0) {  // inside a pruned subtree: dropped
+            --skip_;
+            if (!m.leaf) skip_ += m.count;
+            return;
+        }
+        std::uint32_t at = 0;
+        int depth = 0;
+        if (!t_.nodes.empty()) {
+            if (open_.empty()) throw std::logic_error("model tree: a node after the tree was complete");
+            Slots& s = open_.back();
+            at = s.next++;
+            depth = s.depth;
+            if (s.next == s.end) open_.pop_back();
+        } else {
+            t_.nodes.emplace_back();
+        }
+        const bool reached = whole_ || collect(m, depth);
+        ModelNode& n = t_.nodes[at];
+        n = m;
+        n.depth = depth;
+        if (!reached) {
+            n.leaf = true;
+            n.pruned = true;
+            n.count = 0;
+            n.first = static_cast<std::uint32_t>(t_.prims.size());
+            if (!m.leaf) skip_ += m.count;
+            return;
+        }
+        if (m.leaf) {
+            n.first = static_cast<std::uint32_t>(t_.prims.size());
+            t_.prims.insert(t_.prims.end(), prims.begin(), prims.end());
+        } else {
+            n.first = static_cast<std::uint32_t>(t_.nodes.size());
+            if (m.count > 0) open_.push_back({n.first, n.first + m.count, depth + 1});
+            t_.nodes.resize(t_.nodes.size() + m.count);  // invalidates `n`
+        }
+    }
+
+private:
+    struct Slots {
+        std::uint32_t next, end;
+        int depth;
+    };
+
+    /// Fills the segments that reach the node at `depth` from its parent's (depth - 1) and
+    /// says whether there are any. Depth first, the last list one level up is the parent's.
+    bool collect(const ModelNode& m, int depth) {
+        if (static_cast<std::size_t>(depth) >= by_depth_.size()) by_depth_.resize(depth + 1);
+        std::vector<Reach>& out = by_depth_[depth];
+        out.clear();
+        auto add = [&](std::uint32_t ray, Segment s) {
+            s = clip_segment(inv_[ray], m.region, s);
+            if (s.empty()) return;
+            // The node's children see the segment within its bounding volume.
+            if (m.has_bv) s = clip_segment(inv_[ray], m.bv, s);
+            out.push_back({ray, s});
+        };
+        if (depth == 0) {
+            for (std::uint32_t i = 0; i < inv_.size(); ++i) {
+                const Segment whole{sample_.rays.rays[i].tmin, ends_[i]};
+                if (t_.gated) {
+                    add(i, whole);
+                } else {
+                    Segment s = whole;  // every ray enters an ungated root
+                    if (m.has_bv) s = clip_segment(inv_[i], m.bv, s);
+                    out.push_back({i, s});
+                }
+            }
+            return !out.empty();
+        }
+        bool any = false;
+        for (const Reach& r : by_depth_[depth - 1]) {
+            if (r.s.empty()) continue;  // met the parent's region, not its bounding volume
+            const std::size_t before = out.size();
+            add(r.ray, r.s);
+            any |= out.size() > before;
+        }
+        return any;
+    }
+
+    ModelTree& t_;
+    const RaySample& sample_;
+    bool whole_ = false;
+    std::vector<RayInv> inv_;
+    std::vector<float> ends_;
+    std::vector<std::vector<Reach>> by_depth_;
+    std::vector<Slots> open_;
+    std::uint64_t skip_ = 0;
+};
+
+ModelTree reached_model_tree(const Hierarchy& h, const RaySample& sample) {
+    ModelTree t;
+    ReachCollector c(t, sample);
+    h.emit_model(c);
+    return t;
+}
+
+}  // namespace
+
+SegmentsPredictor::SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample)
+    : h_(h), scene_(scene), sample_(sample) {
+    const auto start = std::chrono::steady_clock::now();
+    tree_ = reached_model_tree(h, sample);
+    tree_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+Prediction SegmentsPredictor::predict(std::span<const std::uint32_t> rays, const ModelOptions& opt,
+                                      const UnitCosts& costs) {
+    if (!whole_) {
+        try {
+            return predict_segments(tree_, scene_, sample_, rays, opt, costs);
+        } catch (const model::PrunedNodeReached&) {
+            // A segment ran on past where the sample said its search ends (e.g. a query other
+            // than the sample's): the whole tree, once, for this and every later prediction.
+            const auto start = std::chrono::steady_clock::now();
+            tree_ = h_.model_tree();
+            whole_ = true;
+            tree_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        }
+    }
+    return predict_segments(tree_, scene_, sample_, rays, opt, costs);
+}
+
+}  // namespace rtcost
