@@ -73,7 +73,7 @@ std::string hierarchy_help() {
     for (const HierarchyInfo* h : hierarchies()) {
         out += fmt::format("  {:<12} {}\n", h->name, h->description);
         for (const ParamSpec& p : h->params)
-            out += fmt::format("      {:<22} {}\n", p.name + "=" + p.default_value, p.help);
+            out += fmt::format("      {:<22} {} [{}]\n", p.name + "=" + p.default_value, p.help, p.domain());
     }
     return out;
 }

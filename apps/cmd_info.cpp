@@ -58,8 +58,16 @@ int cmd_list(const Common& common) {
         json hs = json::array();
         for (const HierarchyInfo* h : hierarchies()) {
             json params = json::array();
-            for (const ParamSpec& p : h->params)
-                params.push_back({{"name", p.name}, {"default", param_json(p.default_value)}, {"help", p.help}});
+            for (const ParamSpec& p : h->params) {
+                json one = {{"name", p.name}, {"default", param_json(p.default_value)}, {"help", p.help},
+                            {"kind", param_kind_name(p.kind)}, {"domain", p.domain()}};
+                if (p.kind == ParamKind::Integer || p.kind == ParamKind::Real) {
+                    one["min"] = p.lo;
+                    one["max"] = p.hi;
+                }
+                if (!p.words.empty()) one["choices"] = p.words;
+                params.push_back(one);
+            }
             hs.push_back({{"name", h->name}, {"description", h->description}, {"params", params}});
         }
         json scenes = json::array();

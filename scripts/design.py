@@ -18,7 +18,9 @@ import time
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.environ.get("RTCOST_SHARED", os.path.join(ROOT, "..", "shared"))
 SPD = ["balls", "gears", "lattice", "mount", "rings", "shells", "sombrero", "teapot", "tetra", "tree"]
-MESHES = ["/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb"]
+# Real meshes of over 50,000 triangles among assimp's test models (Debian's assimp-testmodels).
+MESHES = ["/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
+          "/usr/share/assimp/models/BLEND/yxa_1.blend"]
 
 
 def scene_path(name):

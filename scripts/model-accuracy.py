@@ -21,7 +21,9 @@ import sys
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CLI = os.environ.get("RTCOST_CLI", os.path.join(ROOT, "build", "rtcost"))
 SPD = os.path.join(ROOT, "..", "shared", "scenes", "spd")
-MESHES = ["/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb"]
+# Real meshes of over 50,000 triangles among assimp's test models (Debian's assimp-testmodels).
+MESHES = ["/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
+          "/usr/share/assimp/models/BLEND/yxa_1.blend"]
 ESTIMATORS = ["segments", "sampled", "geometric"]
 
 
@@ -154,16 +156,19 @@ def main():
                     f"({worst[2]} on {worst[0]} {worst[1]}) | {len(errs)} | {rhos[0]:.3f} | "
                     f"{rhos[len(rhos) // 2]:.3f} |\n")
         f.write("\n## Prediction time against tracing the whole distribution\n\n"
-                "Seconds of the segments prediction for one hierarchy (materialising its model tree "
-                "included; drawing the sample, once per scene and distribution, not included) over the "
-                "single-thread seconds of tracing every ray of the distribution through it.\n\n"
-                "| hierarchy | median share | worst share | worst run |\n|---|---|---|---|\n")
+                "Seconds of the segments prediction for one hierarchy (materialising the part of its model "
+                "tree that the sample reaches included; drawing the sample, once per scene and distribution, "
+                "not included) over the single-thread seconds of tracing every ray of the distribution "
+                "through it. The target is 2%; where the sample is itself 2% of the rays (every distribution "
+                "of fewer than 204,800 rays), replaying it costs about 2% of the traversal on its own.\n\n"
+                "| hierarchy | median share | runs within 2% | worst share | worst run |\n|---|---|---|---|---|\n")
         for h in names:
             shares = sorted((r[4]["segments"][2] / r[5], r) for r in rows if r[2] == h and r[5] > 0)
             if not shares:
                 continue
             w = shares[-1]
-            f.write(f"| {h} | {100 * shares[len(shares) // 2][0]:.2f}% | {100 * w[0]:.2f}% | "
+            within = sum(1 for x in shares if x[0] <= 0.02)
+            f.write(f"| {h} | {100 * shares[len(shares) // 2][0]:.2f}% | {within} of {len(shares)} | {100 * w[0]:.2f}% | "
                     f"{w[1][0]} {w[1][1]} |\n")
         f.write("\n## Runs\n\nThe sample is 2% of the distribution's rays (at most 4,096, at least 256); the test rays are "
                 "the rest, less the sampled estimator's training half.\n\n| scene | distribution | test rays | sample | training | " +

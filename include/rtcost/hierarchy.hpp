@@ -123,15 +123,46 @@ public:
 /// for a hierarchy).
 void emit_model(const ModelTree& tree, ModelSink& sink);
 
-/// One named build parameter, declared by the hierarchy with its default and help text.
+/// What values a build parameter takes. One declaration serves `rtcost list` (which prints
+/// it), Params (which checks every value against it before a build starts) and a search over
+/// parameters (which reads the range it may search).
+enum class ParamKind : std::uint8_t {
+    Integer,  ///< a whole number in [lo, hi], or one of `words`
+    Real,     ///< a finite number in [lo, hi], or one of `words`
+    Flag,     ///< 0 or 1 (true/false, on/off, yes/no are read too)
+    Choice,   ///< one of `words`
+    Text,     ///< any text the builder checks itself (a file, a distribution, a resolution)
+};
+
+/// "integer", "real", "flag", "choice" or "text".
+std::string_view param_kind_name(ParamKind k);
+
+/// One named build parameter, declared by the hierarchy with its default, help text and the
+/// values it takes. Make one with the named constructors.
 struct ParamSpec {
     std::string name;
     std::string default_value;
     std::string help;
+    ParamKind kind = ParamKind::Text;
+    double lo = 0, hi = 0;           ///< Integer and Real: the closed range
+    std::vector<std::string> words;  ///< Choice: the values; Integer and Real: words taken besides numbers
+
+    static ParamSpec integer(std::string name, std::string def, long long lo, long long hi, std::string help,
+                             std::vector<std::string> words = {});
+    static ParamSpec real(std::string name, std::string def, double lo, double hi, std::string help,
+                          std::vector<std::string> words = {});
+    static ParamSpec flag(std::string name, std::string def, std::string help);
+    static ParamSpec choice(std::string name, std::string def, std::vector<std::string> words, std::string help);
+    static ParamSpec text(std::string name, std::string def, std::string help);
+    /// The values it takes, for people: "integer in [1, 64]", "one of near, none", "0 or 1".
+    std::string domain() const;
+    /// Empty when `value` is one it takes, else what is wrong with it ("must be in [1, 64]").
+    std::string problem(const std::string& value) const;
 };
 
-/// Validated parameter values of one build (`--set key=value`). Accessors throw InputError
-/// naming the parameter when a value does not parse.
+/// Validated parameter values of one build (`--set key=value`): every value, given or
+/// default, is checked against its declaration when the Params are made (InputError naming
+/// the parameter), so the accessors read a declared, valid value.
 class Params {
 public:
     Params() = default;
@@ -139,15 +170,20 @@ public:
     Params(const std::vector<ParamSpec>& specs, const std::vector<std::string>& assignments);
 
     const std::string& str(const std::string& key) const;
-    long long integer(const std::string& key, long long lo, long long hi) const;
-    double real(const std::string& key, double lo, double hi) const;
+    /// An Integer parameter's number (InputError if it holds one of its words instead).
+    long long integer(const std::string& key) const;
+    /// A Real parameter's number (InputError if it holds one of its words instead).
+    double real(const std::string& key) const;
     bool flag(const std::string& key) const;
-    /// The value must be one of `choices`.
-    const std::string& choice(const std::string& key, std::initializer_list<std::string_view> choices) const;
+    /// Whether the value is `word` (e.g. max_depth=auto).
+    bool is(const std::string& key, std::string_view word) const { return str(key) == word; }
     const std::map<std::string, std::string>& values() const { return values_; }
+    /// The declaration of `key` (InputError if it has none).
+    const ParamSpec& spec(const std::string& key) const;
 
 private:
     std::map<std::string, std::string> values_;
+    std::map<std::string, ParamSpec> specs_;
 };
 
 /// An acceleration structure over a scene. Thread-safe for concurrent queries.

@@ -134,7 +134,8 @@ void bind_hierarchy(pb::module_& m) {
                 pb::list params;
                 for (const ParamSpec& p : info->params)
                     params.append(pb::dict(pb::arg("name") = p.name, pb::arg("default") = to_python(param_json(p.default_value)),
-                                           pb::arg("help") = p.help));
+                                           pb::arg("help") = p.help, pb::arg("kind") = std::string(param_kind_name(p.kind)),
+                                           pb::arg("domain") = p.domain()));
                 out.append(pb::dict(pb::arg("name") = info->name, pb::arg("description") = info->description,
                                     pb::arg("params") = params));
             }

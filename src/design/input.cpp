@@ -8,11 +8,14 @@
 namespace rtcost {
 
 std::vector<ParamSpec> design_param_specs() {
-    return {{"rays", "spd", "distribution the structure is designed for (any name rtcost rays takes)"},
-            {"size", "128x128", "image size WxH of the camera-based rays the sample is drawn from (empty: the scene's)"},
-            {"sample", "4096", "rays in the design sample (at most half the distribution)"},
-            {"seed", "1", "seed of the sample's draw (the distribution's own seed is 1)"},
-            {"costs", "", "costs file of rtcost calibrate (ns per operation); empty: unit costs"}};
+    // Text, not a choice: hierarchies register during static initialisation, possibly before
+    // the ray distributions do; make_rays names the known ones when the name is not one.
+    return {ParamSpec::text("rays", "spd", "distribution the structure is designed for (any name rtcost rays takes)"),
+            ParamSpec::text("size", "128x128",
+                            "image size WxH of the camera-based rays the sample is drawn from (empty: the scene's)"),
+            ParamSpec::integer("sample", "4096", 1, 1 << 20, "rays in the design sample (at most half the distribution)"),
+            ParamSpec::integer("seed", "1", 0, 1LL << 62, "seed of the sample's draw (the distribution's own seed is 1)"),
+            ParamSpec::text("costs", "", "costs file of rtcost calibrate (ns per operation); empty: unit costs")};
 }
 
 DesignInput draw_design_input(const Scene& scene, const Params& p) {
@@ -20,8 +23,8 @@ DesignInput draw_design_input(const Scene& scene, const Params& p) {
     in.spec.name = p.str("rays");
     in.spec.size = p.str("size");
     in.spec.seed = 1;
-    in.count = static_cast<std::size_t>(p.integer("sample", 1, 1 << 20));
-    in.seed = static_cast<std::uint64_t>(p.integer("seed", 0, (1LL << 62)));
+    in.count = static_cast<std::size_t>(p.integer("sample"));
+    in.seed = static_cast<std::uint64_t>(p.integer("seed"));
     if (!p.str("costs").empty()) in.costs = UnitCosts::read(p.str("costs"));
     const RaySet all = make_rays(scene, in.spec);
     const std::size_t n = std::min(in.count, all.rays.size() / 2);

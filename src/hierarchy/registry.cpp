@@ -17,10 +17,6 @@ std::vector<HierarchyInfo>& registry() {
     return table;
 }
 
-[[noreturn]] void bad_param(const std::string& key, const std::string& value, const std::string& want) {
-    throw InputError("--set", 0, fmt::format("{}={}: {}", key, value, want));
-}
-
 }  // namespace
 
 namespace {
@@ -120,64 +116,6 @@ const HierarchyInfo* find_hierarchy(std::string_view name) {
     for (const auto& h : registry())
         if (h.name == name) return &h;
     return nullptr;
-}
-
-Params::Params(const std::vector<ParamSpec>& specs, const std::vector<std::string>& assignments) {
-    for (const auto& s : specs) values_[s.name] = s.default_value;
-    for (const auto& a : assignments) {
-        auto eq = a.find('=');
-        if (eq == std::string::npos || eq == 0) {
-            throw InputError("--set", 0, fmt::format("'{}': expected key=value", a));
-        }
-        std::string key = a.substr(0, eq);
-        if (!values_.contains(key)) {
-            std::string known;
-            for (const auto& s : specs) known += (known.empty() ? "" : ", ") + s.name;
-            throw InputError("--set", 0,
-                             fmt::format("unknown parameter '{}' (known: {})", key, known.empty() ? "none" : known));
-        }
-        values_[key] = a.substr(eq + 1);
-    }
-}
-
-const std::string& Params::str(const std::string& key) const {
-    auto it = values_.find(key);
-    if (it == values_.end()) throw InputError("--set", 0, fmt::format("parameter '{}' is not declared", key));
-    return it->second;
-}
-
-long long Params::integer(const std::string& key, long long lo, long long hi) const {
-    const std::string& v = str(key);
-    long long x = 0;
-    auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
-    if (ec != std::errc() || p != v.data() + v.size()) bad_param(key, v, "expected an integer");
-    if (x < lo || x > hi) bad_param(key, v, fmt::format("must be in [{}, {}]", lo, hi));
-    return x;
-}
-
-double Params::real(const std::string& key, double lo, double hi) const {
-    const std::string& v = str(key);
-    double x = 0;
-    auto [p, ec] = std::from_chars(v.data(), v.data() + v.size(), x);
-    if (ec != std::errc() || p != v.data() + v.size() || !std::isfinite(x)) bad_param(key, v, "expected a number");
-    if (x < lo || x > hi) bad_param(key, v, fmt::format("must be in [{}, {}]", lo, hi));
-    return x;
-}
-
-bool Params::flag(const std::string& key) const {
-    const std::string& v = str(key);
-    if (v == "1" || v == "true" || v == "on" || v == "yes") return true;
-    if (v == "0" || v == "false" || v == "off" || v == "no") return false;
-    bad_param(key, v, "expected 0 or 1");
-}
-
-const std::string& Params::choice(const std::string& key, std::initializer_list<std::string_view> choices) const {
-    const std::string& v = str(key);
-    for (auto c : choices)
-        if (c == v) return v;
-    std::string list;
-    for (auto c : choices) list += (list.empty() ? "" : ", ") + std::string(c);
-    bad_param(key, v, "expected one of " + list);
 }
 
 std::unique_ptr<Hierarchy> build_hierarchy(const Scene& scene, std::string_view name,

@@ -61,9 +61,18 @@ Prediction recurse(const ModelTree& t, const Walk& w, const std::vector<NodeProb
         charge_visit(c, m, t.family, paper, p, pg, prob[i].gamma, pb);
     };
 
-    // Primitive kinds in scene order: looking each reference up in scene.prims would miss the cache.
-    std::vector<std::uint8_t> kind(scene.size());
-    for (std::uint32_t id = 0; id < kind.size(); ++id) kind[id] = static_cast<std::uint8_t>(scene.kind(id));
+    // Primitive kinds: scenes of one kind (most meshes) need no look-up per reference; an array
+    // of the scene's kinds (a look-up in scene.prims would miss the cache) costs a pass over the
+    // scene, more than a prediction from a sample that reaches a few leaves.
+    const auto counts = scene.kind_counts();
+    int only = -1;
+    for (int k = 0; k < kPrimKinds; ++k)
+        if (counts[k] == scene.size() && scene.size() > 0) only = k;
+    std::vector<std::uint8_t> kind;
+    if (only < 0) {
+        kind.resize(scene.size());
+        for (std::uint32_t id = 0; id < kind.size(); ++id) kind[id] = static_cast<std::uint8_t>(scene.kind(id));
+    }
     for (std::size_t i = 0; i < n; ++i) {
         const ModelNode& m = t.nodes[i];
         const NodeProbabilities& q = prob[i];
@@ -82,8 +91,11 @@ Prediction recurse(const ModelTree& t, const Walk& w, const std::vector<NodeProb
             if (terminate && q.ordered) {
                 for (int k = 0; k < kPrimKinds; ++k) c.prim[k] += pg * q.tests[k];
             } else {
-                for (std::uint32_t k = 0; k < m.count; ++k)
-                    c.prim[kind[t.prims[m.first + k]]] += pg;
+                if (only >= 0) {
+                    c.prim[only] += pg * m.count;
+                } else {
+                    for (std::uint32_t k = 0; k < m.count; ++k) c.prim[kind[t.prims[m.first + k]]] += pg;
+                }
             }
             if (t.locate) {
                 // Every cell is found by a descent from the root: its ancestors' work again.

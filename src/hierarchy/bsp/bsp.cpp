@@ -122,7 +122,7 @@ const Registration reg{
      "Kaplan's BSP tree: binary, spatial mid-plane, axes X, Y, Z in turn",
      subdiv::param_specs(20, kMaxDepth, 2),
      [](const Scene& s, const Params& p) {
-         return std::make_unique<Bsp>(s, subdiv::read_options<Options>(p, kMaxDepth));
+         return std::make_unique<Bsp>(s, subdiv::read_options<Options>(p));
      }},
     {{{}, kTestHits | kTestSampled | kTestSpdModel | kTestSubdivision},
      {{"traversal=recursive", "assign=exact", "mailbox=1"}, kTestHits | kTestSubdivision},

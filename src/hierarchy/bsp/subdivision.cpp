@@ -45,9 +45,9 @@ std::vector<std::uint32_t> Assigner::select(const std::vector<std::uint32_t>& re
 }
 
 std::vector<ParamSpec> param_specs(int default_depth, int max_depth, int default_prims) {
-    return {{"max_depth", std::to_string(default_depth),
-             "deepest leaf (root at 0; at most " + std::to_string(max_depth) + ")"},
-            {"max_prims", std::to_string(default_prims), "a node with at most this many references is a leaf"},
+    return {ParamSpec::integer("max_depth", std::to_string(default_depth), 0, max_depth, "deepest leaf (root at 0)"),
+            ParamSpec::integer("max_prims", std::to_string(default_prims), 1, 1 << 20,
+                               "a node with at most this many references is a leaf"),
             kTraversalParam,
             spatial::kAssignParam,
             kGrowthParam,

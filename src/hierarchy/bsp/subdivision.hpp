@@ -140,10 +140,10 @@ bool test_leaf(const Scene& s, const std::uint32_t* refs, std::uint32_t count, i
     return false;
 }
 
-inline const ParamSpec kTraversalParam{
-    "traversal", "locate",
+inline const ParamSpec kTraversalParam = ParamSpec::choice(
+    "traversal", "locate", {"locate", "recursive"},
     "locate: each next cell found by a descent from the root at the current cell's exit (the original); "
-    "recursive: front-to-back recursion over the children"};
+    "recursive: front-to-back recursion over the children");
 
 /// Guard against subdivision that separates nothing (cells around a vertex shared by a fan of
 /// triangles; spheres overlapping by the hundred, as in shells.nff): a node stays a leaf when its
@@ -153,10 +153,10 @@ inline const ParamSpec kTraversalParam{
 /// (growth=9) and costs fewer tests and steps per ray (teapot N_IT 5.1 vs 6.1); on shells the
 /// unguarded build runs into kMaxRefs (33M references), the guarded one holds 1.4M (bsp) and 3.2M
 /// (octree).
-inline const ParamSpec kGrowthParam{
-    "growth", "6",
-    "a node stays a leaf when its eight octants would hold at least growth x its references together "
-    "(1..9; 8: only when no octant loses one; 9: never)"};
+inline const ParamSpec kGrowthParam = ParamSpec::real(
+    "growth", "6", 1, 9,
+    "a node stays a leaf when its eight octants (a BSP node: those of its next three planes) would hold at least "
+    "growth x its references together (8: only when no octant loses one; 9: never)");
 
 /// An optional termination test both builders call with a cell about to be split: its box, its
 /// reference count, and the `k` children it would get with their reference counts; false keeps
@@ -168,14 +168,14 @@ std::vector<ParamSpec> param_specs(int default_depth, int max_depth, int default
 
 /// Reads those parameters into either's options.
 template <class O>
-O read_options(const Params& p, int max_depth) {
+O read_options(const Params& p) {
     O o;
-    o.max_depth = static_cast<int>(p.integer("max_depth", 0, max_depth));
-    o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
-    o.locate = p.choice("traversal", {"locate", "recursive"}) == "locate";
+    o.max_depth = static_cast<int>(p.integer("max_depth"));
+    o.max_prims = static_cast<int>(p.integer("max_prims"));
+    o.locate = p.is("traversal", "locate");
     o.assign = spatial::parse_assign(p);
     o.mailbox = p.flag("mailbox");
-    o.growth = p.real("growth", 1, 9);
+    o.growth = p.real("growth");
     return o;
 }
 

@@ -221,25 +221,28 @@ const Registration reg{
      "binned BVH whose splits minimise the cost model with visit probabilities from a sample of the given rays",
      [] {
          std::vector<ParamSpec> p = design_param_specs();
-         p.push_back({"max_prims", "32", "largest leaf (bigger nodes are always split)"});
-         p.push_back({"max_depth", "64", "deepest leaf"});
-         p.push_back({"bins", "16", "bins per axis"});
-         p.push_back({"candidates", "8", "surface-area-cheapest splits weighed again with the sample"});
-         p.push_back({"occlusion", "near",
-                      "order in which occlusion rays enter a node's children: near (front to back, as every BVH; "
-                      "the model describes it) or sample (the child likelier to end the ray per primitive first, "
-                      "an order bit per node; outside the model's exact replay)"});
-         p.push_back({"trust", "32", "sample segments at a node at which sample and surface area weigh alike "
-                                     "(large: the surface area heuristic)"});
+         p.push_back(ParamSpec::integer("max_prims", "32", 1, 1 << 20, "largest leaf (bigger nodes are always split)"));
+         p.push_back(ParamSpec::integer("max_depth", "64", 0, kMaxDepth, "deepest leaf"));
+         p.push_back(ParamSpec::integer("bins", "16", 2, 256, "bins per axis"));
+         p.push_back(ParamSpec::integer("candidates", "8", 1, 3 * 256,
+                                        "surface-area-cheapest splits weighed again with the sample"));
+         p.push_back(ParamSpec::choice(
+             "occlusion", "near", {"near", "sample"},
+             "order in which occlusion rays enter a node's children: near (front to back, as every BVH; the model "
+             "describes it) or sample (the child likelier to end the ray per primitive first, an order bit per "
+             "node; outside the model's exact replay)"));
+         p.push_back(ParamSpec::real("trust", "32", 0, 1e30,
+                                     "sample segments at a node at which sample and surface area weigh alike "
+                                     "(large: the surface area heuristic)"));
          return p;
      }(),
      [](const Scene& s, const Params& p) -> std::unique_ptr<Hierarchy> {
          DesignOptions o;
-         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
-         o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
-         o.bins = static_cast<int>(p.integer("bins", 2, 256));
-         o.candidates = static_cast<int>(p.integer("candidates", 1, 3 * 256));
-         o.trust = p.real("trust", 0, 1e30);
+         o.max_prims = static_cast<int>(p.integer("max_prims"));
+         o.max_depth = static_cast<int>(p.integer("max_depth"));
+         o.bins = static_cast<int>(p.integer("bins"));
+         o.candidates = static_cast<int>(p.integer("candidates"));
+         o.trust = p.real("trust");
          const DesignInput in = draw_design_input(s, p);
          Designed d = build_design(s, in, o);
          // bvh-sah's tree (front-to-back order) where the model predicts it cheaper on the sample
@@ -249,7 +252,7 @@ const Registration reg{
          usual.bins = o.bins;
          auto designed = std::make_unique<Bvh>(s, "bvh-design", d.data, true);
          auto by_sah = std::make_unique<Bvh>(s, "bvh-design", build_sah(s, usual), true);
-         if (p.choice("occlusion", {"near", "sample"}) == "near")
+         if (p.is("occlusion", "near"))
              return designing::cheaper_on_sample(std::move(designed), std::move(by_sah), s, in);
          if (sample_cost(*by_sah, s, in.sample, in.costs) <
              sample_cost(*designed, s, in.sample, in.costs))

@@ -276,16 +276,16 @@ namespace {
 
 std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p) {
     const bool avx2 = cpu_has_avx2();
-    const std::string& simd = p.choice("simd", {"auto", "baseline", "avx2"});
+    const std::string& simd = p.str("simd");
     if (simd == "avx2" && !avx2) throw InputError("bvh-wide", 0, "simd=avx2: this CPU does not run AVX2");
     const bool use_avx2 = avx2 && simd != "baseline";
-    const std::string& w = p.choice("width", {"auto", "4", "8"});
+    const std::string& w = p.str("width");
     auto d = std::make_unique<BvhWide::Data>();
     d->width = w == "4" ? 4 : w == "8" ? 8 : (use_avx2 ? 8 : 4);
     bvh::SahOptions o;
-    o.max_prims = static_cast<int>(p.integer("max_prims", 1, 64));
-    o.bins = static_cast<int>(p.integer("bins", 2, 256));
-    o.c_trav = static_cast<float>(p.real("c_trav", 0, 1e6));
+    o.max_prims = static_cast<int>(p.integer("max_prims"));
+    o.bins = static_cast<int>(p.integer("bins"));
+    o.c_trav = static_cast<float>(p.real("c_trav"));
     o.max_depth = 64;  // bvh-sah's default; the wide tree is never deeper
     bvh::BvhData bd = bvh::build_sah(s, o);
     if (!s.empty()) {
@@ -307,12 +307,15 @@ std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p) {
 const Registration reg{
     {"bvh-wide",
      "4- or 8-wide BVH collapsed from the binned SAH tree; SIMD box tests of all children, nearest first",
-     {{"width", "auto", "children per node: 4, 8, or auto (8 where the CPU runs AVX2, else 4)"},
-      {"simd", "auto", "instruction set of the traversal: auto, baseline (SSE2) or avx2"},
-      {"max_prims", "16", "largest leaf of the SAH tree collapsed (bigger nodes are always split)"},
-      {"bins", "16", "SAH bins per axis"},
-      {"c_trav", "4", "SAH cost of a traversal step, relative to a primitive test (triangles are tested 4 or 8 "
-                      "at a time, so leaves are larger than bvh-sah's)"}},
+     {ParamSpec::choice("width", "auto", {"auto", "4", "8"},
+                        "children per node: 4, 8, or auto (8 where the CPU runs AVX2, else 4)"),
+      ParamSpec::choice("simd", "auto", {"auto", "baseline", "avx2"},
+                        "instruction set of the traversal: auto, baseline (SSE2) or avx2"),
+      ParamSpec::integer("max_prims", "16", 1, 64, "largest leaf of the SAH tree collapsed (bigger nodes are always split)"),
+      ParamSpec::integer("bins", "16", 2, 256, "SAH bins per axis"),
+      ParamSpec::real("c_trav", "4", 0, 1e6,
+                      "SAH cost of a traversal step, relative to a primitive test (triangles are tested 4 or 8 at a "
+                      "time, so leaves are larger than bvh-sah's)")},
      build},
     {{{}, kTestHits | kTestSampled},
      {{"width=4"}, kTestHits | kTestSampled},

@@ -49,20 +49,22 @@ bool Bvh::emit_model(ModelSink& sink) const {
 
 namespace {
 
-bool ordered(const Params& p) { return p.choice("order", {"near", "none"}) == "near"; }
+bool ordered(const Params& p) { return p.is("order", "near"); }
 
-const ParamSpec kOrder{"order", "near",
-                       "near: near child first, far child skipped beyond the current hit; none: every child "
-                       "met is visited (the paper's BVH case)"};
+const ParamSpec kOrder = ParamSpec::choice("order", "near", {"near", "none"},
+                                           "near: near child first, far child skipped beyond the current hit; "
+                                           "none: every child met is visited (the paper's BVH case)");
+constexpr long long kMaxLeaf = 1 << 20;
 
 const Registration median_reg{
     {"bvh-median",
      "Kay and Kajiya's BVH: object median cut on the longest axis",
-     {{"max_prims", "1", "largest leaf"}, {"max_depth", "64", "deepest leaf (root at 0)"}, kOrder},
+     {ParamSpec::integer("max_prims", "1", 1, kMaxLeaf, "largest leaf"),
+      ParamSpec::integer("max_depth", "64", 0, kMaxDepth, "deepest leaf (root at 0)"), kOrder},
      [](const Scene& s, const Params& p) {
          MedianOptions o;
-         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
-         o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
+         o.max_prims = static_cast<int>(p.integer("max_prims"));
+         o.max_depth = static_cast<int>(p.integer("max_depth"));
          return std::make_unique<Bvh>(s, "bvh-median", build_median(s, o), ordered(p));
      }},
     {{{}, kTestHits | kTestSampled | kTestSpdModel},
@@ -71,18 +73,19 @@ const Registration median_reg{
 const Registration gs_reg{
     {"bvh-gs",
      "Goldsmith and Salmon's BVH: incremental insertion minimising surface-area cost",
-     {{"max_prims", "1", "largest leaf (1: one object per leaf, as in the original)"},
-      {"max_depth", "64", "deepest node"},
-      {"max_children", "8", "largest fan-out of a node (2..8)"},
-      {"seed", "1", "insertion order: shuffled with this seed; 0 = file order (which degenerates on "
-                   "meshes stored row by row)"},
+     {ParamSpec::integer("max_prims", "1", 1, kMaxLeaf, "largest leaf (1: one object per leaf, as in the original)"),
+      ParamSpec::integer("max_depth", "64", 1, kMaxDepth, "deepest node"),
+      ParamSpec::integer("max_children", "8", 2, kMaxFanout, "largest fan-out of a node"),
+      ParamSpec::integer("seed", "1", 0, 1LL << 62,
+                         "insertion order: shuffled with this seed; 0 = file order (which degenerates on "
+                         "meshes stored row by row)"),
       kOrder},
      [](const Scene& s, const Params& p) {
          GsOptions o;
-         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
-         o.max_depth = static_cast<int>(p.integer("max_depth", 1, kMaxDepth));
-         o.max_children = static_cast<int>(p.integer("max_children", 2, kMaxFanout));
-         o.seed = static_cast<std::uint64_t>(p.integer("seed", 0, 1LL << 62));
+         o.max_prims = static_cast<int>(p.integer("max_prims"));
+         o.max_depth = static_cast<int>(p.integer("max_depth"));
+         o.max_children = static_cast<int>(p.integer("max_children"));
+         o.seed = static_cast<std::uint64_t>(p.integer("seed"));
          return std::make_unique<Bvh>(s, "bvh-gs", build_gs(s, o), ordered(p));
      },
      kLargeScene},  // insertion from the root, one object at a time: 10 s for a million
@@ -93,21 +96,21 @@ const Registration gs_reg{
 const Registration sah_reg{
     {"bvh-sah",
      "binned SAH BVH (Wald 2007); sweep=1 for the full sweep",
-     {{"max_prims", "8", "largest leaf (bigger nodes are always split)"},
-      {"max_depth", "64", "deepest leaf"},
-      {"bins", "16", "bins per axis for the binned build"},
-      {"sweep", "0", "1: evaluate every split of the sorted centroids (full sweep SAH)"},
-      {"c_trav", "1", "SAH cost of a traversal step"},
-      {"c_isect", "1", "SAH cost of a primitive test"},
+     {ParamSpec::integer("max_prims", "8", 1, kMaxLeaf, "largest leaf (bigger nodes are always split)"),
+      ParamSpec::integer("max_depth", "64", 0, kMaxDepth, "deepest leaf"),
+      ParamSpec::integer("bins", "16", 2, 256, "bins per axis for the binned build"),
+      ParamSpec::flag("sweep", "0", "1: evaluate every split of the sorted centroids (full sweep SAH)"),
+      ParamSpec::real("c_trav", "1", 0, 1e6, "SAH cost of a traversal step"),
+      ParamSpec::real("c_isect", "1", 1e-6, 1e6, "SAH cost of a primitive test"),
       kOrder},
      [](const Scene& s, const Params& p) {
          SahOptions o;
-         o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
-         o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
-         o.bins = static_cast<int>(p.integer("bins", 2, 256));
+         o.max_prims = static_cast<int>(p.integer("max_prims"));
+         o.max_depth = static_cast<int>(p.integer("max_depth"));
+         o.bins = static_cast<int>(p.integer("bins"));
          o.sweep = p.flag("sweep");
-         o.c_trav = static_cast<float>(p.real("c_trav", 0, 1e6));
-         o.c_isect = static_cast<float>(p.real("c_isect", 1e-6, 1e6));
+         o.c_trav = static_cast<float>(p.real("c_trav"));
+         o.c_isect = static_cast<float>(p.real("c_isect"));
          return std::make_unique<Bvh>(s, "bvh-sah", build_sah(s, o), ordered(p));
      }},
     {{{}, kTestHits | kTestSampled | kTestSpdModel},

@@ -54,7 +54,7 @@ bool sphere_surface_meets_box(const Sphere& s, const Box3& b) {
 }  // namespace
 
 Assign parse_assign(const Params& p) {
-    return p.choice("assign", {"bounds", "exact"}) == "exact" ? Assign::Exact : Assign::Bounds;
+    return p.is("assign", "exact") ? Assign::Exact : Assign::Bounds;
 }
 
 bool overlaps(const Scene& s, std::uint32_t id, const Box3& pb, const Box3& cell, Assign how) {

@@ -23,9 +23,9 @@ enum class Assign {
     Exact,   ///< every cell its surface really meets (conservative where exactness is not cheap)
 };
 
-inline const ParamSpec kAssignParam{"assign", "bounds",
-                                    "bounds: cells the primitive's box overlaps; exact: cells its surface meets"};
-inline const ParamSpec kMailboxParam{"mailbox", "0", "1: each primitive tested at most once per ray"};
+inline const ParamSpec kAssignParam = ParamSpec::choice(
+    "assign", "bounds", {"bounds", "exact"}, "bounds: cells the primitive's box overlaps; exact: cells its surface meets");
+inline const ParamSpec kMailboxParam = ParamSpec::flag("mailbox", "0", "1: each primitive tested at most once per ray");
 
 Assign parse_assign(const Params& p);
 

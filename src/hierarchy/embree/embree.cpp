@@ -19,14 +19,14 @@ public:
     bool counted() const override { return false; }
 
     EmbreeHierarchy(const Scene& scene, const Params& p) : Hierarchy(scene) {
-        long long threads = p.integer("threads", 0, 1024);
+        long long threads = p.integer("threads");
         std::string config = threads > 0 ? "threads=" + std::to_string(threads) : "";
         device_ = rtcNewDevice(config.c_str());
         if (!device_) throw InputError("embree", 0, "cannot create an Embree device");
         rtcSetDeviceMemoryMonitorFunction(device_, &EmbreeHierarchy::monitor, this);
         rs_ = rtcNewScene(device_);
         rtcSetSceneFlags(rs_, p.flag("robust") ? RTC_SCENE_FLAG_ROBUST : RTC_SCENE_FLAG_NONE);
-        const std::string& q = p.choice("quality", {"low", "medium", "high"});
+        const std::string& q = p.str("quality");
         rtcSetSceneBuildQuality(rs_, q == "low" ? RTC_BUILD_QUALITY_LOW
                                      : q == "high" ? RTC_BUILD_QUALITY_HIGH
                                                    : RTC_BUILD_QUALITY_MEDIUM);
@@ -197,9 +197,9 @@ private:
 
 const Registration reg{{"embree",
                         "Embree 3 BVH (reference peer; its internal operations are not counted)",
-                        {{"quality", "medium", "Embree build quality: low, medium or high"},
-                         {"robust", "1", "RTC_SCENE_FLAG_ROBUST: no accuracy-reducing shortcuts"},
-                         {"threads", "0", "Embree's build threads (0: all cores)"}},
+                        {ParamSpec::choice("quality", "medium", {"low", "medium", "high"}, "Embree build quality"),
+                         ParamSpec::flag("robust", "1", "RTC_SCENE_FLAG_ROBUST: no accuracy-reducing shortcuts"),
+                         ParamSpec::integer("threads", "0", 0, 1024, "Embree's build threads (0: all cores)")},
                         [](const Scene& s, const Params& p) { return std::make_unique<EmbreeHierarchy>(s, p); }}};
 
 }  // namespace

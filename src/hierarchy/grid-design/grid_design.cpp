@@ -68,7 +68,7 @@ namespace {
 
 std::vector<ParamSpec> params() {
     std::vector<ParamSpec> p = design_param_specs();
-    p.push_back({"max_density", "8", "largest candidate grid, in cells per primitive"});
+    p.push_back(ParamSpec::real("max_density", "8", 0.01, 64, "largest candidate grid, in cells per primitive"));
     p.push_back(spatial::kAssignParam);
     p.push_back(spatial::kMailboxParam);
     return p;
@@ -82,7 +82,7 @@ const Registration reg{
          const DesignInput in = draw_design_input(s, p);
          const spatial::Assign assign = spatial::parse_assign(p);
          const bool mailbox = p.flag("mailbox");
-         const double md = p.real("max_density", 0.01, 64);
+         const double md = p.real("max_density");
          const auto max_cells =
              std::min<std::uint64_t>(kMaxCells, static_cast<std::uint64_t>(std::max(1.0, md * static_cast<double>(s.size()))) + 64);
          std::vector<Candidate> tried = search_resolution(s, in, assign, mailbox, max_cells);

@@ -308,15 +308,16 @@ const Registration reg{
      // Default hetero: of the three formulas the only one that gives about D*N cells, as cubic as
      // possible, whatever the box's shape (the common rule of Cleary-Wyvill, Havran, Wald et al.);
      // woo gives D*N only for a cube (balls: 361 cells for 7382 primitives).
-     {{"res", "hetero",
-       "hetero: Klimaszewski's cubic cells, about D*N of them; woo: L=(D*N)^(1/3), res_i=floor(size_i/max_size*L); "
-       "regular: round(D*N^(1/3)) on every axis; or AxBxC. Each axis in [1, 1024], a flat axis gets 1, formula "
-       "grids are scaled down to at most 2^24 cells"},
-      {"density", "1", "D in the resolution formulas (cells per primitive for woo and hetero); ignored for AxBxC"},
+     {ParamSpec::text("res", "hetero",
+                      "hetero: Klimaszewski's cubic cells, about D*N of them; woo: L=(D*N)^(1/3), "
+                      "res_i=floor(size_i/max_size*L); regular: round(D*N^(1/3)) on every axis; or AxBxC. Each axis "
+                      "in [1, 1024], a flat axis gets 1, formula grids are scaled down to at most 2^24 cells"),
+      ParamSpec::real("density", "1", 1e-3, 1e3,
+                      "D in the resolution formulas (cells per primitive for woo and hetero); ignored for AxBxC"),
       spatial::kAssignParam,
       spatial::kMailboxParam},
      [](const Scene& s, const Params& p) {
-         const double density = p.real("density", 1e-3, 1e3);
+         const double density = p.real("density");
          const std::array<int, 3> res = resolution(p.str("res"), density, s.size(), s.bounds());
          return std::make_unique<Grid>(s, res, spatial::parse_assign(p), p.flag("mailbox"));
      }},

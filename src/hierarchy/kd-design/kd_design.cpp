@@ -35,8 +35,8 @@ const Registration reg{
      "kd-sah's planes, terminated where the cost model with a sample of the given rays says a split does not pay",
      [] {
          std::vector<ParamSpec> p = design_param_specs();
-         p.push_back({"max_depth", "auto", "deepest leaf: auto (8 + 1.3 log2 N) or 0..64"});
-         p.push_back({"trust", "32", "sample segments at a node at which sample and surface area weigh alike"});
+         p.push_back(kMaxDepthParam);
+         p.push_back(ParamSpec::real("trust", "32", 0, 1e30, "sample segments at a node at which sample and surface area weigh alike"));
          p.push_back(spatial::kAssignParam);
          p.push_back(spatial::kMailboxParam);
          return p;
@@ -44,10 +44,10 @@ const Registration reg{
      [](const Scene& s, const Params& p) -> std::unique_ptr<Hierarchy> {
          const DesignInput in = draw_design_input(s, p);
          // An interior visit of kd-sah's traversal: one plane.
-         Designer d{{}, designing::CellRays(s, in, p.real("trust", 0, 1e30), in.costs.plane)};
+         Designer d{{}, designing::CellRays(s, in, p.real("trust"), in.costs.plane)};
          d.sah.build.max_prims = 0;
-         d.sah.build.max_depth = p.str("max_depth") == "auto" ? default_max_depth(s.size())
-                                                              : static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
+         d.sah.build.max_depth = p.is("max_depth", "auto") ? default_max_depth(s.size())
+                                                              : static_cast<int>(p.integer("max_depth"));
          d.sah.build.assign = spatial::parse_assign(p);
          const Chooser choose = [&d](const std::vector<BuildRef>& refs, const Box3& cell, int) {
              return d.choose(refs, cell);

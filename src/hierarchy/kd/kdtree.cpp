@@ -149,17 +149,14 @@ bool KdTree::emit_model(ModelSink& sink) const {
 namespace {
 
 int max_depth(const Params& p, const Scene& s) {
-    if (p.str("max_depth") == "auto") return default_max_depth(s.size());
-    return static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
+    if (p.is("max_depth", "auto")) return default_max_depth(s.size());
+    return static_cast<int>(p.integer("max_depth"));
 }
-
-const ParamSpec kMaxDepthParam{"max_depth", "auto",
-                               "deepest leaf (root at 0), 0..64; auto: 8 + 1.3 log2 N (Havran, Wald)"};
 
 BuildOptions common(const Params& p, const Scene& s) {
     BuildOptions o;
     o.max_depth = max_depth(p, s);
-    o.max_prims = static_cast<int>(p.integer("max_prims", 1, 1 << 20));
+    o.max_prims = static_cast<int>(p.integer("max_prims"));
     o.assign = spatial::parse_assign(p);
     return o;
 }
@@ -168,7 +165,7 @@ const Registration median_reg{
     {"kd-median",
      "Fussell and Subramanian's median-cut kd-tree: count-balancing planes with few straddlers, free axis, "
      "a box per node tested before its plane",
-     {{"max_prims", "1", "a node with at most this many references is a leaf"},
+     {ParamSpec::integer("max_prims", "1", 1, 1 << 20, "a node with at most this many references is a leaf"),
       kMaxDepthParam,
       spatial::kAssignParam,
       spatial::kMailboxParam},
@@ -184,19 +181,19 @@ const Registration median_reg{
 const Registration sah_reg{
     {"kd-sah",
      "SAH kd-tree (MacDonald and Booth's cost, Wald and Havran's termination and empty-space bonus)",
-     {{"max_prims", "1", "a node with at most this many references is a leaf"},
+     {ParamSpec::integer("max_prims", "1", 1, 1 << 20, "a node with at most this many references is a leaf"),
       kMaxDepthParam,
-      {"c_trav", "15", "SAH cost of a traversal step (Wald and Havran's K_T)"},
-      {"c_isect", "20", "SAH cost of a primitive test (K_I)"},
-      {"empty_bonus", "0.2", "a split with an empty side costs (1 - empty_bonus) x its SAH cost"},
+      ParamSpec::real("c_trav", "15", 0, 1e6, "SAH cost of a traversal step (Wald and Havran's K_T)"),
+      ParamSpec::real("c_isect", "20", 1e-6, 1e6, "SAH cost of a primitive test (K_I)"),
+      ParamSpec::real("empty_bonus", "0.2", 0, 1, "a split with an empty side costs (1 - empty_bonus) x its SAH cost"),
       spatial::kAssignParam,
       spatial::kMailboxParam},
      [](const Scene& s, const Params& p) {
          SahOptions o;
          o.build = common(p, s);
-         o.c_trav = static_cast<float>(p.real("c_trav", 0, 1e6));
-         o.c_isect = static_cast<float>(p.real("c_isect", 1e-6, 1e6));
-         o.empty_bonus = static_cast<float>(p.real("empty_bonus", 0, 1));
+         o.c_trav = static_cast<float>(p.real("c_trav"));
+         o.c_isect = static_cast<float>(p.real("c_isect"));
+         o.empty_bonus = static_cast<float>(p.real("empty_bonus"));
          return std::make_unique<KdTree>(s, "kd-sah", build_sah(s, o), p.flag("mailbox"));
      },
      kLargeScene},  // O(N log^2 N) build: 17 s for a million triangles

@@ -87,6 +87,10 @@ struct BuildOptions {
 /// The default depth limit of Havran and Wald: 8 + 1.3 log2 N, at most kMaxDepth.
 int default_max_depth(std::size_t n);
 
+/// The depth limit every kd-tree declares: a number, or auto (default_max_depth).
+inline const ParamSpec kMaxDepthParam = ParamSpec::integer(
+    "max_depth", "auto", 0, kMaxDepth, "deepest leaf (root at 0); auto: 8 + 1.3 log2 N (Havran, Wald)", {"auto"});
+
 /// Top-down build: the root cell is the scene box, each node split where `choose` says, its
 /// references handed to the children they overlap (options.assign).
 KdData build_tree(const Scene& s, const BuildOptions& o, const Chooser& choose);

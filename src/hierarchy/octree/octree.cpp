@@ -133,7 +133,7 @@ const Registration reg{
      "Glassner's octree: eight children at the centre",
      subdiv::param_specs(8, kMaxDepth, 1),
      [](const Scene& s, const Params& p) {
-         return std::make_unique<Octree>(s, subdiv::read_options<Options>(p, kMaxDepth));
+         return std::make_unique<Octree>(s, subdiv::read_options<Options>(p));
      }},
     {{{}, kTestHits | kTestSampled | kTestSpdModel | kTestSubdivision},
      {{"traversal=recursive", "max_prims=4"}, kTestHits},

@@ -273,21 +273,23 @@ namespace {
 const Registration reg{
     {"rc5d",
      "Arvo and Kirk's 5D ray classification: beams over ray origin (x, y, z) and direction (u, v)",
-     {{"max_prims", "8", "a beam with at most this many candidates is not subdivided"},
-      {"max_depth", "30",
-       "subdivision levels below each of the six direction cubes, cycling x, y, z, u, v (0: one beam per cube; at "
-       "most 60)"},
-      {"build", "lazy",
-       "lazy: a beam is subdivided when the first ray reaches it (Arvo and Kirk); eager: everything at build time"},
-      {"max_bytes", "1073741824",
-       "memory cap in bytes: subdivision stops where the structure would exceed it (at most 2^36; a bound always "
-       "holds, as eager builds grow exponentially); with a cap that is reached, lazy and eager trees can differ"}},
+     {ParamSpec::integer("max_prims", "8", 0, 1 << 30, "a beam with at most this many candidates is not subdivided"),
+      ParamSpec::integer("max_depth", "30", 0, kMaxDepth,
+                         "subdivision levels below each of the six direction cubes, cycling x, y, z, u, v (0: one "
+                         "beam per cube)"),
+      ParamSpec::choice("build", "lazy", {"lazy", "eager"},
+                        "lazy: a beam is subdivided when the first ray reaches it (Arvo and Kirk); eager: everything "
+                        "at build time"),
+      ParamSpec::integer("max_bytes", "1073741824", 1, 1LL << 36,
+                         "memory cap in bytes: subdivision stops where the structure would exceed it (a bound always "
+                         "holds, as eager builds grow exponentially); with a cap that is reached, lazy and eager "
+                         "trees can differ")},
      [](const Scene& s, const Params& p) {
          Options o;
-         o.max_prims = static_cast<int>(p.integer("max_prims", 0, 1 << 30));
-         o.max_depth = static_cast<int>(p.integer("max_depth", 0, kMaxDepth));
-         o.lazy = p.choice("build", {"lazy", "eager"}) == "lazy";
-         o.max_bytes = static_cast<std::uint64_t>(p.integer("max_bytes", 1, 1LL << 36));
+         o.max_prims = static_cast<int>(p.integer("max_prims"));
+         o.max_depth = static_cast<int>(p.integer("max_depth"));
+         o.lazy = p.is("build", "lazy");
+         o.max_bytes = static_cast<std::uint64_t>(p.integer("max_bytes"));
          return std::make_unique<Rc5d>(s, o);
      }},
     {{{}, kTestHits},

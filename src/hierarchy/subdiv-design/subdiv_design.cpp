@@ -14,7 +14,7 @@ namespace {
 std::vector<ParamSpec> specs(int default_depth, int max_depth, int default_prims) {
     std::vector<ParamSpec> p = design_param_specs();
     for (const ParamSpec& q : subdiv::param_specs(default_depth, max_depth, default_prims)) p.push_back(q);
-    p.push_back({"trust", "32", "sample segments at a cell at which sample and surface area weigh alike"});
+    p.push_back(ParamSpec::real("trust", "32", 0, 1e30, "sample segments at a cell at which sample and surface area weigh alike"));
     return p;
 }
 
@@ -22,11 +22,11 @@ std::vector<ParamSpec> specs(int default_depth, int max_depth, int default_prims
 // build) and with the yardstick's depth and leaf size (`usual_depth`, `usual_prims`), and keeps
 // the one the model predicts cheaper on the sample.
 template <class H, class O>
-std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, int max_depth, double planes, const char* name,
+std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, double planes, const char* name,
                                  int usual_depth, int usual_prims) {
     const DesignInput in = draw_design_input(s, p);
-    designing::CellRays cells(s, in, p.real("trust", 0, 1e30), planes * in.costs.plane);
-    O o = subdiv::read_options<O>(p, max_depth);
+    designing::CellRays cells(s, in, p.real("trust"), planes * in.costs.plane);
+    O o = subdiv::read_options<O>(p);
     o.name = name;
     O usual = o;
     usual.max_depth = usual_depth;
@@ -42,7 +42,7 @@ const Registration octree_reg{
     {"octree-design", "Glassner's octree, a cell split only where the cost model with a sample of the given rays says it pays",
      specs(12, octree::kMaxDepth, 1),
      [](const Scene& s, const Params& p) {
-         return build<octree::Octree, octree::Options>(s, p, octree::kMaxDepth, 3, "octree-design", 8, 1);
+         return build<octree::Octree, octree::Options>(s, p, 3, "octree-design", 8, 1);
      },
      kLargeScene}};  // every candidate split replayed on the sample: 10 s for a million triangles
 
@@ -50,7 +50,7 @@ const Registration bsp_reg{
     {"bsp-design", "Kaplan's BSP tree, a cell split only where the cost model with a sample of the given rays says it pays",
      specs(30, bsp::kMaxDepth, 1),
      [](const Scene& s, const Params& p) {
-         return build<bsp::Bsp, bsp::Options>(s, p, bsp::kMaxDepth, 1, "bsp-design", 20, 2);
+         return build<bsp::Bsp, bsp::Options>(s, p, 1, "bsp-design", 20, 2);
      }}};
 
 }  // namespace
