@@ -29,9 +29,9 @@ def scene_path(name):
     return os.path.join(SHARED, "scenes", "spd", name + ".nff")
 
 
-def run(binary, scene, dist, families, size, sample):
+def run(binary, scene, dist, families, size, sample, costs=None):
     cmd = ["taskset", "-c", "0", binary, "design", scene, "--rays", dist, "--size", size,
-           "--family", families, "--sample", str(sample), "--json", "--quiet"]
+           "--family", families, "--sample", str(sample), "--json", "--quiet"] + (["--costs", costs] if costs else [])
     start = time.time()
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     return json.loads(out), time.time() - start
@@ -147,6 +147,7 @@ def main():
     ap.add_argument("--families", default="all")
     ap.add_argument("--size", default="128x128")
     ap.add_argument("--sample", type=int, default=4096)
+    ap.add_argument("--costs", help="costs file passed to rtcost design --costs (default: the design's own)")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "design.md"))
     ap.add_argument("--sweep-scenes", default=",".join(SPD), help="scenes of the grid and kd sweeps ('' for none)")
     ap.add_argument("--sweep-dist", default="spd")
@@ -169,7 +170,7 @@ def main():
             continue
         for dist in a.dists.split(","):
             print(f"{os.path.basename(path)} {dist}", file=sys.stderr, flush=True)
-            doc, secs = run(a.binary, path, dist, a.families, a.size, a.sample)
+            doc, secs = run(a.binary, path, dist, a.families, a.size, a.sample, a.costs)
             for r in doc["results"]:
                 rows.append((os.path.basename(path), dist, {"sample": doc["sample"], "test_rays": doc["test_rays"]}, r))
     if not a.from_raw and a.sweep_scenes:

@@ -96,14 +96,34 @@ TEST(Design, DesignSampleIsEvalsOwnDraw) {
     for (std::size_t i = 0; i < want.size(); ++i) ASSERT_EQ(in.sample.rays.rays[i].o, want.rays.rays[i].o) << i;
 }
 
+TEST(Design, DesignsMinimiseTypicalTimeUnlessToldOtherwise) {
+    const Scene s = builtin_scene("balls", 2);
+    const std::vector<std::string> base = {"rays=camera", "size=16x16", "sample=64"};
+    const DesignInput typical = draw_design_input(s, Params(design_param_specs(), base));
+    EXPECT_TRUE(typical.costs.calibrated);
+    EXPECT_EQ(typical.costs.box, UnitCosts::typical().box);
+    // A polygon test costs several box tests: what operation counts alone leave out.
+    EXPECT_GT(typical.costs.prim[static_cast<int>(PrimKind::Polygon)], 4 * typical.costs.box);
+    std::vector<std::string> unit = base;
+    unit.push_back("costs=unit");
+    const DesignInput counts = draw_design_input(s, Params(design_param_specs(), unit));
+    EXPECT_FALSE(counts.costs.calibrated);
+    EXPECT_EQ(counts.costs.box, 1.0);
+    EXPECT_EQ(counts.costs.prim[0], 1.0);
+    std::vector<std::string> missing = base;
+    missing.push_back("costs=/nonexistent/costs.json");
+    EXPECT_THROW(draw_design_input(s, Params(design_param_specs(), missing)), InputError);
+}
+
 TEST(Design, BvhDesignWithNoSampleWeightIsTheSahTree) {
-    // trust=1e30: the sample weighs nothing, and the split cost is the SAH's with a traversal
-    // step of two box tests and a primitive test of one: bvh-sah's tree, node for node.
+    // trust=1e30: the sample weighs nothing, and with unit costs the split cost is the SAH's
+    // with a traversal step of two box tests and a primitive test of one: bvh-sah's tree, node
+    // for node.
     for (const char* scene : {"builtin:balls:2", "builtin:tetra:3", "gears", "tree"}) {
         const std::string spec = spec_of(scene);
         if (spec.rfind("builtin:", 0) != 0 && !std::filesystem::exists(spec)) continue;
         const Scene s = load_scene(spec);
-        auto d = build_hierarchy(s, "bvh-design", {"rays=camera", "size=16x16", "sample=64", "trust=1e30", "max_prims=8"});
+        auto d = build_hierarchy(s, "bvh-design", {"rays=camera", "size=16x16", "sample=64", "trust=1e30", "max_prims=8", "costs=unit"});
         auto sah = build_hierarchy(s, "bvh-sah", {"c_trav=2"});
         expect_same_tree(d->model_tree(), sah->model_tree(), scene);
     }

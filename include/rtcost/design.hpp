@@ -64,14 +64,17 @@ struct DesignOptions {
     std::vector<std::string> families;    ///< empty: all
     std::size_t sample = 4096;
     std::uint64_t seed = 1;               ///< the sample's draw
-    std::string costs_file;               ///< calibrated ns; empty: unit costs
+    /// What the designs minimise and the table reports: a calibrated costs file (ns), "unit"
+    /// (operations), or empty: typical ns per operation (UnitCosts::typical), operations reported.
+    std::string costs_file;
     std::function<void(const std::string&)> on_step;
 };
 
 struct DesignResult {
     std::string scene, distribution;
     std::size_t sample = 0, test_rays = 0;
-    bool calibrated = false;
+    bool calibrated = false;            ///< the table is in a costs file's ns (else operations)
+    std::string designed_for = "typical";  ///< what the designs minimised: typical, unit or a file
     std::vector<DesignRow> rows;
 };
 

@@ -40,6 +40,13 @@ struct UnitCosts {
     /// Reads a costs file (JSON `{"unit": "ns", "box": ns, "plane": ns, ..., "per_ray": ns,
     /// "prim": {"triangle": ns, ...}}`).
     static UnitCosts read(const std::string& path);
+    /// Typical nanoseconds per operation, built in: what the designed hierarchies minimise
+    /// unless told otherwise, because operation counts alone trade box tests for primitive
+    /// tests that cost several times more (docs/design.md). Fitted by `rtcost calibrate` on one
+    /// machine (unit_costs.cpp says which); their ratios, not their nanoseconds, steer a design.
+    static UnitCosts typical();
+    /// "unit" (operation counts), "typical" (typical()) or a costs file's path.
+    static UnitCosts named(const std::string& name);
 };
 
 /// One calibration run: the measured operations per ray and the measured single-thread
@@ -146,6 +153,8 @@ public:
     double tree_seconds() const { return tree_seconds_; }
     /// The tree predictions are made on (pruned until a replay needed the whole one).
     const ModelTree& tree() const { return tree_; }
+    /// A hierarchy of at most this many nodes per sample ray is materialised whole.
+    static constexpr std::size_t kWholeNodesPerRay = 16;
 
 private:
     const Hierarchy& h_;

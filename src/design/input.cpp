@@ -15,7 +15,9 @@ std::vector<ParamSpec> design_param_specs() {
                             "image size WxH of the camera-based rays the sample is drawn from (empty: the scene's)"),
             ParamSpec::integer("sample", "4096", 1, 1 << 20, "rays in the design sample (at most half the distribution)"),
             ParamSpec::integer("seed", "1", 0, 1LL << 62, "seed of the sample's draw (the distribution's own seed is 1)"),
-            ParamSpec::text("costs", "", "costs file of rtcost calibrate (ns per operation); empty: unit costs")};
+            ParamSpec::text("costs", "typical",
+                            "ns per operation the design minimises: typical (built in), unit (operation counts), or a "
+                            "costs file of rtcost calibrate")};
 }
 
 DesignInput draw_design_input(const Scene& scene, const Params& p) {
@@ -25,7 +27,7 @@ DesignInput draw_design_input(const Scene& scene, const Params& p) {
     in.spec.seed = 1;
     in.count = static_cast<std::size_t>(p.integer("sample"));
     in.seed = static_cast<std::uint64_t>(p.integer("seed"));
-    if (!p.str("costs").empty()) in.costs = UnitCosts::read(p.str("costs"));
+    in.costs = UnitCosts::named(p.str("costs"));
     const RaySet all = make_rays(scene, in.spec);
     const std::size_t n = std::min(in.count, all.rays.size() / 2);
     if (n == 0) throw InputError("--set", 0, "rays=" + in.spec.name + ": too few rays to draw a design sample from");

@@ -157,7 +157,11 @@ ModelTree reached_model_tree(const Hierarchy& h, const RaySample& sample) {
 SegmentsPredictor::SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample)
     : h_(h), scene_(scene), sample_(sample) {
     const auto start = std::chrono::steady_clock::now();
-    tree_ = reached_model_tree(h, sample);
+    // A tree of a few nodes per sample ray (a BVH) is reached nearly everywhere: finding where
+    // the segments reach would repeat the replay's clipping for nothing, so it is taken whole.
+    const StructureStats st = h.structure();
+    whole_ = st.interior + st.leaves <= kWholeNodesPerRay * std::max<std::size_t>(sample.size(), 1);
+    tree_ = whole_ ? h.model_tree() : reached_model_tree(h, sample);
     tree_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
