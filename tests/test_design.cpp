@@ -110,6 +110,15 @@ TEST(Design, DesignsMinimiseTypicalTimeUnlessToldOtherwise) {
     EXPECT_FALSE(counts.costs.calibrated);
     EXPECT_EQ(counts.costs.box, 1.0);
     EXPECT_EQ(counts.costs.prim[0], 1.0);
+    // Each family's default: time where the fitted costs describe its traversal, else counts.
+    for (const auto& [name, want] : std::vector<std::pair<std::string, std::string>>{
+             {"bvh-design", "typical"}, {"kd-design", "typical"}, {"grid-design", "unit"},
+             {"octree-design", "unit"}, {"bsp-design", "unit"}}) {
+        std::string got;
+        for (const ParamSpec& p : find_hierarchy(name)->params)
+            if (p.name == "costs") got = p.default_value;
+        EXPECT_EQ(got, want) << name;
+    }
     std::vector<std::string> missing = base;
     missing.push_back("costs=/nonexistent/costs.json");
     EXPECT_THROW(draw_design_input(s, Params(design_param_specs(), missing)), InputError);

@@ -20,8 +20,12 @@
 namespace rtcost {
 
 /// The parameters of every designed hierarchy, with their defaults (rays=spd, sample=4096,
-/// seed=1, costs= unit costs, size=128x128: the image of camera-based rays the sample is drawn from).
-std::vector<ParamSpec> design_param_specs();
+/// seed=1, size=128x128: the image of camera-based rays the sample is drawn from) and the
+/// family's default `costs`: "typical" where typical ns per operation describe the family's
+/// traversal time (BVHs, kd-trees: docs/design.md measured gains with them), "unit" where they
+/// do not (the subdivisions' locate traversals and grids, whose time the fit leaves 30-75% off
+/// and whose designs lost against unit costs).
+std::vector<ParamSpec> design_param_specs(const std::string& default_costs = "typical");
 
 /// A designed hierarchy's sample and the costs it minimises.
 struct DesignInput {
@@ -65,7 +69,8 @@ struct DesignOptions {
     std::size_t sample = 4096;
     std::uint64_t seed = 1;               ///< the sample's draw
     /// What the designs minimise and the table reports: a calibrated costs file (ns), "unit"
-    /// (operations), or empty: typical ns per operation (UnitCosts::typical), operations reported.
+    /// (operations), "typical", or empty: each family's default (design_param_specs), operations
+    /// reported.
     std::string costs_file;
     std::function<void(const std::string&)> on_step;
 };
@@ -74,7 +79,8 @@ struct DesignResult {
     std::string scene, distribution;
     std::size_t sample = 0, test_rays = 0;
     bool calibrated = false;            ///< the table is in a costs file's ns (else operations)
-    std::string designed_for = "typical";  ///< what the designs minimised: typical, unit or a file
+    /// What the designs minimised: each family's default, typical, unit or a file.
+    std::string designed_for = "each family's default";
     std::vector<DesignRow> rows;
 };
 

@@ -56,7 +56,7 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
     // The table reports operations unless a costs file is given; the designs minimise the
     // named costs (typical ns per operation by default).
     res.calibrated = !opt.costs_file.empty() && opt.costs_file != "unit" && opt.costs_file != "typical";
-    res.designed_for = opt.costs_file.empty() ? "typical" : opt.costs_file;
+    res.designed_for = opt.costs_file.empty() ? "each family's default" : opt.costs_file;
     UnitCosts costs;
     if (res.calibrated) costs = UnitCosts::read(opt.costs_file);
     for (const auto& fam : families) {
@@ -133,7 +133,9 @@ nlohmann::json to_json(const DesignResult& r) {
 }
 
 std::string design_table(const DesignResult& r) {
-    const std::string aim = r.designed_for == "typical" ? "typical ns per operation (built in)"
+    const std::string aim = r.designed_for == "each family's default"
+                                ? "each family's default: typical ns per operation (bvh, kd), operations (grid, octree, bsp)"
+                            : r.designed_for == "typical" ? "typical ns per operation (built in)"
                             : r.designed_for == "unit"  ? "operations (unit costs)"
                                                         : "ns per operation of " + r.designed_for;
     std::string s = fmt::format("scene      {}\nrays       {}: design sample {}, test rays {} (disjoint)\ncosts      {}\n"

@@ -7,7 +7,7 @@
 
 namespace rtcost {
 
-std::vector<ParamSpec> design_param_specs() {
+std::vector<ParamSpec> design_param_specs(const std::string& default_costs) {
     // Text, not a choice: hierarchies register during static initialisation, possibly before
     // the ray distributions do; make_rays names the known ones when the name is not one.
     return {ParamSpec::text("rays", "spd", "distribution the structure is designed for (any name rtcost rays takes)"),
@@ -15,7 +15,7 @@ std::vector<ParamSpec> design_param_specs() {
                             "image size WxH of the camera-based rays the sample is drawn from (empty: the scene's)"),
             ParamSpec::integer("sample", "4096", 1, 1 << 20, "rays in the design sample (at most half the distribution)"),
             ParamSpec::integer("seed", "1", 0, 1LL << 62, "seed of the sample's draw (the distribution's own seed is 1)"),
-            ParamSpec::text("costs", "typical",
+            ParamSpec::text("costs", default_costs,
                             "ns per operation the design minimises: typical (built in), unit (operation counts), or a "
                             "costs file of rtcost calibrate")};
 }

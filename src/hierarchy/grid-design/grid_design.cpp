@@ -67,7 +67,7 @@ std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, 
 namespace {
 
 std::vector<ParamSpec> params() {
-    std::vector<ParamSpec> p = design_param_specs();
+    std::vector<ParamSpec> p = design_param_specs("unit");
     p.push_back(ParamSpec::real("max_density", "8", 0.01, 64, "largest candidate grid, in cells per primitive"));
     p.push_back(spatial::kAssignParam);
     p.push_back(spatial::kMailboxParam);
