@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 #include <stdexcept>
 
+#include "common/model_collector.hpp"
 #include "rtcost/error.hpp"
 #include "rtcost/hierarchy.hpp"
 
@@ -20,49 +21,6 @@ std::vector<HierarchyInfo>& registry() {
 }  // namespace
 
 namespace {
-
-/// Materialises an emitted tree: a node's children get contiguous slots when the node arrives,
-/// and are filled as their subtrees follow.
-class Collector final : public ModelSink {
-public:
-    explicit Collector(ModelTree& t) : t_(t) {}
-    bool begin(const ModelFlags& f) override {
-        static_cast<ModelFlags&>(t_) = f;
-        return true;
-    }
-    void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
-        std::uint32_t at = 0;
-        int depth = 0;
-        if (!t_.nodes.empty()) {
-            if (open_.empty()) throw std::logic_error("model tree: a node after the tree was complete");
-            Slots& s = open_.back();
-            at = s.next++;
-            depth = s.depth;
-            if (s.next == s.end) open_.pop_back();
-        } else {
-            t_.nodes.emplace_back();
-        }
-        ModelNode& n = t_.nodes[at];
-        n = m;
-        n.depth = depth;
-        if (m.leaf) {
-            n.first = static_cast<std::uint32_t>(t_.prims.size());
-            t_.prims.insert(t_.prims.end(), prims.begin(), prims.end());
-        } else {
-            n.first = static_cast<std::uint32_t>(t_.nodes.size());
-            if (m.count > 0) open_.push_back({n.first, n.first + m.count, depth + 1});
-            t_.nodes.resize(t_.nodes.size() + m.count);  // invalidates `n`
-        }
-    }
-
-private:
-    struct Slots {
-        std::uint32_t next, end;
-        int depth;
-    };
-    ModelTree& t_;
-    std::vector<Slots> open_;
-};
 
 /// Declines the nodes: only asks whether there is a tree.
 class Asker final : public ModelSink {
@@ -90,7 +48,7 @@ bool Hierarchy::modelled() const {
 
 ModelTree Hierarchy::model_tree() const {
     ModelTree t;
-    Collector c(t);
+    ModelCollector c(t);
     emit_model(c);
     return t;
 }

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "hierarchy/common/model_collector.hpp"
 #include "model_internal.hpp"
 #include "rtcost/sample.hpp"
 
@@ -25,12 +26,12 @@ struct Reach {
 /// the sample's segments meets by a pruned empty leaf (its nodes are read and dropped). Which
 /// segments reach a node is found the way the probe finds it: the parent's segment (clipped to
 /// the parent's bounding volume) clipped to the child's region.
-class ReachCollector final : public ModelSink {
+class ReachCollector final : public ModelCollector {
 public:
-    ReachCollector(ModelTree& t, const RaySample& sample) : t_(t), sample_(sample) {}
+    ReachCollector(ModelTree& t, const RaySample& sample) : ModelCollector(t), sample_(sample) {}
 
     bool begin(const ModelFlags& f) override {
-        static_cast<ModelFlags&>(t_) = f;
+        ModelCollector::begin(f);
         // 5D trees classify rays instead of clipping them: kept whole.
         whole_ = f.one_path;
         const std::size_t n = sample_.size();
@@ -54,50 +55,8 @@ public:
         return true;
     }
 
-    void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
-        if (skip_ > 0) {  // inside a pruned subtree: dropped
-            --skip_;
-            if (!m.leaf) skip_ += m.count;
-            return;
-        }
-        std::uint32_t at = 0;
-        int depth = 0;
-        if (!t_.nodes.empty()) {
-            if (open_.empty()) throw std::logic_error("model tree: a node after the tree was complete");
-            Slots& s = open_.back();
-            at = s.next++;
-            depth = s.depth;
-            if (s.next == s.end) open_.pop_back();
-        } else {
-            t_.nodes.emplace_back();
-        }
-        const bool reached = whole_ || collect(m, depth);
-        ModelNode& n = t_.nodes[at];
-        n = m;
-        n.depth = depth;
-        if (!reached) {
-            n.leaf = true;
-            n.pruned = true;
-            n.count = 0;
-            n.first = static_cast<std::uint32_t>(t_.prims.size());
-            if (!m.leaf) skip_ += m.count;
-            return;
-        }
-        if (m.leaf) {
-            n.first = static_cast<std::uint32_t>(t_.prims.size());
-            t_.prims.insert(t_.prims.end(), prims.begin(), prims.end());
-        } else {
-            n.first = static_cast<std::uint32_t>(t_.nodes.size());
-            if (m.count > 0) open_.push_back({n.first, n.first + m.count, depth + 1});
-            t_.nodes.resize(t_.nodes.size() + m.count);  // invalidates `n`
-        }
-    }
-
 private:
-    struct Slots {
-        std::uint32_t next, end;
-        int depth;
-    };
+    bool keep(const ModelNode& m, int depth) override { return whole_ || collect(m, depth); }
 
     /// Fills the segments that reach the node at `depth` from its parent's (depth - 1) and
     /// says whether there are any. Depth first, the last list one level up is the parent's.
@@ -135,14 +94,11 @@ private:
         return any;
     }
 
-    ModelTree& t_;
     const RaySample& sample_;
     bool whole_ = false;
     std::vector<RayInv> inv_;
     std::vector<float> ends_;
     std::vector<std::vector<Reach>> by_depth_;
-    std::vector<Slots> open_;
-    std::uint64_t skip_ = 0;
 };
 
 ModelTree reached_model_tree(const Hierarchy& h, const RaySample& sample) {
