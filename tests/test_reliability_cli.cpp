@@ -58,6 +58,9 @@ TEST(ReliabilityCli, CountSizeAndThreadsAreValidatedClearly) {
 TEST(ReliabilityCli, RayFileThatIsADirectoryIsNamed) {
     const std::string d = dir().string();
     EXPECT_BAD_INPUT(rtcost("trace builtin:tetra:2 --rays " + d), d + ": is a directory");
+    // A costs file that is a directory: the designs' --set costs and eval's --costs.
+    EXPECT_BAD_INPUT(rtcost("build builtin:tetra:2 -H bvh-design --set size=16x16 --set costs=" + d), d + ": is a directory");
+    EXPECT_BAD_INPUT(rtcost("eval builtin:tetra:2 -H bvh-sah --size 16x16 --costs " + d), d + ": is a directory");
 }
 
 TEST(ReliabilityCli, OutputsOntoDevicesLinksAndDirectories) {

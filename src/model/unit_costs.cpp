@@ -1,5 +1,6 @@
 // Unit costs (operation counts, or calibrated ns) and the measured cost vector.
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
 
@@ -38,6 +39,8 @@ UnitCosts UnitCosts::named(const std::string& name) {
 }
 
 UnitCosts UnitCosts::read(const std::string& path) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw InputError(path, 0, "is a directory");
     std::ifstream in(path);
     if (!in) throw InputError(path, 0, "no such file");
     nlohmann::json j;
