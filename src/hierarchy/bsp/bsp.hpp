@@ -6,10 +6,11 @@
 // (root at 0), or, at the top of a block of three levels (depth 0, 3, 6, ...; the block ends in
 // the cell's eight octants, the octree's cells), when the growth guard says that the block would
 // hardly separate its references: the octants would hold at least `growth` (default 6) times as
-// many (subdivision.hpp). Beyond that,
-// subdiv::kMaxRefs / kMaxNodes stop the build (never reached with sane parameters).
+// many (common/subdivision.hpp). Beyond that, subdiv::kMaxRefs / kMaxNodes stop the build (never
+// reached with sane parameters).
 //
-// Traversal (see subdivision.hpp for how cells are found by the ray parameter t):
+// Traversal (the loops are common/cell_tree.hpp's; common/subdivision.hpp says how cells are
+// found by the ray parameter t):
 //  - locate (default, Kaplan's): from the root clip's entry t, descend from the root to the leaf
 //    holding the ray just after t; test its primitives; the cell's exit is the smallest crossing
 //    bounding it from above (or the root exit); stop when the closest hit so far lies at or before
@@ -27,10 +28,9 @@
 // this ray).
 
 #include <cstdint>
-#include <string_view>
 #include <vector>
 
-#include "subdivision.hpp"
+#include "../common/cell_tree.hpp"
 
 namespace rtcost::bsp {
 
@@ -45,170 +45,94 @@ struct Node {
     std::uint32_t count : 30 = 0;
     std::uint32_t axis : 2 = 3;
     bool leaf() const { return axis == 3; }
+    void make_leaf(std::uint32_t first, std::uint32_t n) {
+        axis = 3;
+        index = first;
+        count = n;
+    }
 };
 static_assert(sizeof(Node) == 12);
 
-struct Options {
-    int max_depth = 20;
-    int max_prims = 2;
-    spatial::Assign assign = spatial::Assign::Bounds;
-    bool locate = true;
-    bool mailbox = false;
-    double growth = 6;  ///< see subdiv::kGrowthParam
-    subdiv::SplitTest split_pays;  ///< when set, a cell is split only where this says it pays
-    std::string name = "bsp";  ///< the registered name (a designed variant's)
-};
+using Options = subdiv::CellOptions;
 
-class Bsp final : public HierarchyImpl<Bsp> {
+class Bsp final : public subdiv::CellTree<Bsp, Node> {
 public:
-    Bsp(const Scene& s, const Options& o);
+    static constexpr const char* kFamily = "bsp";
+    static constexpr unsigned kArity = 2;
+    static constexpr ModelFamily kModelFamily = ModelFamily::Bsp;
+    static constexpr int kLocateStack = kMaxDepth + 8;  // one extra per axis the ray lies in
+    static constexpr int kRecursiveStack = kMaxDepth + 2;  // one waiting child per level
 
-    std::string_view name() const override { return o_.name; }
-    bool emit_model(ModelSink& sink) const override;
+    Bsp(const Scene& s, const Options& o) : CellTree(s, o) {}
 
-    const Box3& root() const { return root_; }
-    const std::vector<Node>& nodes() const { return nodes_; }
-    const std::vector<std::uint32_t>& refs() const { return refs_; }
+    /// The two halves at the mid-plane of axis depth % 3; none where the growth guard, at the
+    /// top of a block of three levels, keeps the cell a leaf.
+    int split(const Box3& cell, int depth, const std::vector<std::uint32_t>& refs, const subdiv::Assigner& as,
+              Box3* kids, std::vector<std::uint8_t>& mask, std::array<std::size_t, 8>& counts) const;
+    void make_interior(Node& n, const Box3& cell, int depth, std::uint32_t first) const;
 
-    template <class C, Query Q>
-    bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        if (o_.locate) return o_.mailbox ? locate<C, Q, true>(ray, hit, counting) : locate<C, Q, false>(ray, hit, counting);
-        return o_.mailbox ? recursive<C, Q, true>(ray, hit, counting) : recursive<C, Q, false>(ray, hit, counting);
-    }
-
-protected:
-    StructureStats compute_structure() const override;
-    StructureStats compute_tree() const;
-    bool capped_ = false;  ///< the references or nodes bound stopped the build somewhere
-
-private:
-    void build(std::uint32_t node, const Box3& cell, int depth, std::vector<std::uint32_t>& refs,
-               const subdiv::Assigner& as);
-    void make_leaf(std::uint32_t node, const std::vector<std::uint32_t>& refs);
-
-    // A leaf's references through subdiv::test_leaf; true when an any-hit query may stop.
-    template <class C, Query Q, bool kMailbox>
-    bool test_leaf(const Node& n, int depth, const Ray& ray, Hit& hit, C& counting, spatial::Mailbox* mb,
-                   bool& found) const {
-        return subdiv::test_leaf<C, Q, kMailbox>(*scene_, refs_.data() + n.index, n.count, depth, ray, hit, counting,
-                                                 mb, found);
-    }
-
-    template <class C, Query Q, bool kMailbox>
-    bool locate(const Ray& ray, Hit& hit, C& counting) const {
-        counting.box();
-        const subdiv::CellRay r(ray);
-        float t, t_end;
-        if (!subdiv::clip_root(root_, r.ri, ray.tmin, ray.tmax, t, t_end)) return false;
-        spatial::Mailbox* mb = nullptr;
-        if constexpr (kMailbox) mb = &spatial::Mailbox::begin_ray(this, scene_->size());
-        const Node* nodes = nodes_.data();
-        bool found = false;
-        struct Item {
-            std::uint32_t node;
-            int depth;
-            float up;  // smallest crossing above t on the path so far: the cell's exit
-        };
-        // A descent branches only at a plane the ray lies in, at most once per axis on a path.
-        Item stack[kMaxDepth + 8];
-        for (;;) {
-            // Descend to every leaf holding the ray just after t (one, unless the ray lies in a
-            // split plane); the stretch they share ends at the smallest of their exits.
-            float exit = t_end;
-            int sp = 0;
-            stack[sp++] = {0, 0, t_end};
-            while (sp > 0) {
-                const Item it = stack[--sp];
-                const Node& n = nodes[it.node];
-                if (n.leaf()) {
-                    if (test_leaf<C, Q, kMailbox>(n, it.depth, ray, hit, counting, mb, found)) return true;
-                    exit = it.up < exit ? it.up : exit;
-                    continue;
-                }
-                counting.interior(it.depth);
-                counting.plane();
-                const int a = static_cast<int>(n.axis);
-                if (r.moving[a]) {
-                    const float ts = r.cross(a, n.split);
-                    const bool high = r.high_after(a, ts, t);
-                    const float up = r.leaves(a, high) && ts < it.up ? ts : it.up;
-                    stack[sp++] = {n.index + (high ? 1u : 0u), it.depth + 1, up};
-                } else if (r.ri.o[a] != n.split) {
-                    stack[sp++] = {n.index + (r.ri.o[a] > n.split ? 1u : 0u), it.depth + 1, it.up};
-                } else {
-                    stack[sp++] = {n.index + 1, it.depth + 1, it.up};
-                    stack[sp++] = {n.index, it.depth + 1, it.up};
-                }
-            }
-            // A hit up to and including the exit lies in these cells: nothing later is nearer.
-            if constexpr (Q != Query::All) {
-                if (hit.t <= exit) return found;
-            }
-            if (exit >= t_end) return found;
-            t = exit;  // strictly greater than before: every exit bounds its cell from above
+    template <class C, class Push>
+    void locate_children(const Node& n, const subdiv::CellRay& r, float t, float up, C& counting, Push push) const {
+        counting.plane();
+        const int a = static_cast<int>(n.axis);
+        if (r.moving[a]) {
+            const float ts = r.cross(a, n.split);
+            const bool high = r.high_after(a, ts, t);
+            push(n.index + (high ? 1u : 0u), r.leaves(a, high) && ts < up ? ts : up);
+        } else if (r.ri.o[a] != n.split) {
+            push(n.index + (r.ri.o[a] > n.split ? 1u : 0u), up);
+        } else {
+            push(n.index + 1, up);
+            push(n.index, up);
         }
     }
 
-    template <class C, Query Q, bool kMailbox>
-    bool recursive(const Ray& ray, Hit& hit, C& counting) const {
-        counting.box();
-        const subdiv::CellRay r(ray);
-        struct Entry {
-            std::uint32_t node;
-            float t0, t1;
-            int depth;
-            bool may_end;  // false on the low side of a plane the ray lies in
-        };
-        Entry e{0, 0, 0, 0, true};
-        if (!subdiv::clip_root(root_, r.ri, ray.tmin, ray.tmax, e.t0, e.t1)) return false;
-        spatial::Mailbox* mb = nullptr;
-        if constexpr (kMailbox) mb = &spatial::Mailbox::begin_ray(this, scene_->size());
-        const Node* nodes = nodes_.data();
-        bool found = false;
-        Entry stack[kMaxDepth + 2];  // at most one waiting child per level
-        int sp = 0;
-        for (;;) {
-            const Node& n = nodes[e.node];
-            if (n.leaf()) {
-                if (test_leaf<C, Q, kMailbox>(n, e.depth, ray, hit, counting, mb, found)) return true;
-                if constexpr (Q != Query::All) {
-                    if (e.may_end && hit.t <= e.t1) return found;
-                }
-                if (sp == 0) return found;
-                e = stack[--sp];
-                continue;
+    template <class C>
+    int recursive_children(const Node& n, const subdiv::CellRay& r, const subdiv::CellEntry& e, C& counting,
+                           subdiv::CellEntry* out) const {
+        counting.plane();
+        const int a = static_cast<int>(n.axis);
+        const int depth = e.depth + 1;
+        if (r.moving[a]) {
+            const float ts = r.cross(a, n.split);
+            const std::uint32_t near = n.index + (r.ri.neg[a] ? 1u : 0u);
+            const std::uint32_t far = n.index + (r.ri.neg[a] ? 0u : 1u);
+            // The half-open partition: the near side holds [t0, ts), the far one [ts, t1].
+            const bool want_near = e.t0 < ts;
+            const bool want_far = ts < e.t1 || !want_near;
+            if (want_near && want_far) {
+                out[0] = {near, e.t0, ts, depth, e.may_end};
+                out[1] = {far, ts, e.t1, depth, e.may_end};
+                return 2;
             }
-            counting.interior(e.depth);
-            counting.plane();
-            const int a = static_cast<int>(n.axis);
-            const int depth = e.depth + 1;
-            if (r.moving[a]) {
-                const float ts = r.cross(a, n.split);
-                const std::uint32_t near = n.index + (r.ri.neg[a] ? 1u : 0u);
-                const std::uint32_t far = n.index + (r.ri.neg[a] ? 0u : 1u);
-                // The half-open partition: the near side holds [t0, ts), the far one [ts, t1].
-                const bool want_near = e.t0 < ts;
-                const bool want_far = ts < e.t1 || !want_near;
-                if (want_near && want_far) {
-                    stack[sp++] = {far, ts, e.t1, depth, e.may_end};
-                    e = {near, e.t0, ts, depth, e.may_end};
-                } else {
-                    e = {want_near ? near : far, e.t0, e.t1, depth, e.may_end};
-                }
-            } else if (r.ri.o[a] != n.split) {
-                e = {n.index + (r.ri.o[a] > n.split ? 1u : 0u), e.t0, e.t1, depth, e.may_end};
-            } else {
-                // In the plane: both sides cover the same stretch, the low one may not end it.
-                stack[sp++] = {n.index + 1, e.t0, e.t1, depth, e.may_end};
-                e = {n.index, e.t0, e.t1, depth, false};
-            }
+            out[0] = {want_near ? near : far, e.t0, e.t1, depth, e.may_end};
+            return 1;
         }
+        if (r.ri.o[a] != n.split) {
+            out[0] = {n.index + (r.ri.o[a] > n.split ? 1u : 0u), e.t0, e.t1, depth, e.may_end};
+            return 1;
+        }
+        // In the plane: both sides cover the same stretch, the low one may not end it.
+        out[0] = {n.index, e.t0, e.t1, depth, false};
+        out[1] = {n.index + 1, e.t0, e.t1, depth, e.may_end};
+        return 2;
     }
 
-    Options o_;
-    Box3 root_;
-    std::vector<Node> nodes_;
-    std::vector<std::uint32_t> refs_;
+    /// One model node per BSP node: a visit costs one plane compare and is one step.
+    template <class Child>
+    void emit_interior(ModelSink& sink, const Node& n, const Box3& region, Child child) const {
+        const int a = static_cast<int>(n.axis);
+        ModelNode m;
+        m.region = region;
+        m.step = true;
+        m.leaf = false;
+        m.count = 2;
+        m.axis = static_cast<std::int8_t>(a);
+        m.split = n.split;
+        m.plane = 1;
+        sink.node(m, {});
+        for (int side = 0; side < 2; ++side) child(n.index + side, subdiv::half(region, a, n.split, side));
+    }
 };
 
 }  // namespace rtcost::bsp

@@ -5,10 +5,11 @@
 // Build: a node is a leaf when it holds at most `max_prims` references (default 1, Glassner's)
 // or lies at `max_depth` (root at 0), or when the growth guard says subdividing would hardly
 // separate its references: its octants would hold at least `growth` (default 6) times as many
-// (see bsp/subdivision.hpp). Beyond that, subdiv::kMaxRefs / kMaxNodes stop the build (never
+// (see common/subdivision.hpp). Beyond that, subdiv::kMaxRefs / kMaxNodes stop the build (never
 // reached with sane parameters).
 //
-// Traversal (see bsp/subdivision.hpp for how cells are found by the ray parameter t):
+// Traversal (the loops are common/cell_tree.hpp's; common/subdivision.hpp says how cells are
+// found by the ray parameter t):
 //  - locate (default, Glassner's): from the root clip's entry t, descend from the root to the
 //    leaf holding the ray just after t (at each node the octant by three compares with the
 //    centre), test it, and descend again at its exit until the closest hit lies at or before the
@@ -27,10 +28,9 @@
 // a primitive's first test in this ray).
 
 #include <cstdint>
-#include <string_view>
 #include <vector>
 
-#include "../bsp/subdivision.hpp"
+#include "../common/cell_tree.hpp"
 
 namespace rtcost::octree {
 
@@ -45,199 +45,143 @@ struct Node {
     std::uint32_t count : 31 = 0;
     std::uint32_t is_leaf : 1 = 1;
     bool leaf() const { return is_leaf; }
+    void make_leaf(std::uint32_t first, std::uint32_t n) {
+        is_leaf = 1;
+        index = first;
+        count = n;
+    }
 };
 static_assert(sizeof(Node) == 20);
 
-struct Options {
-    int max_depth = 8;
-    int max_prims = 1;
-    spatial::Assign assign = spatial::Assign::Bounds;
-    bool locate = true;
-    bool mailbox = false;
-    double growth = 6;  ///< see subdiv::kGrowthParam
-    subdiv::SplitTest split_pays;  ///< when set, a cell is split only where this says it pays
-    std::string name = "octree";  ///< the registered name (a designed variant's)
-};
+using Options = subdiv::CellOptions;
 
-class Octree final : public HierarchyImpl<Octree> {
+class Octree final : public subdiv::CellTree<Octree, Node> {
 public:
-    Octree(const Scene& s, const Options& o);
+    static constexpr const char* kFamily = "octree";
+    static constexpr unsigned kArity = 8;
+    static constexpr ModelFamily kModelFamily = ModelFamily::Octree;
+    static constexpr int kLocateStack = 8 * (kMaxDepth + 2);
+    static constexpr int kRecursiveStack = 8 * (kMaxDepth + 2);  // at most seven waiting children per level
 
-    std::string_view name() const override { return o_.name; }
-    bool emit_model(ModelSink& sink) const override;
+    Octree(const Scene& s, const Options& o) : CellTree(s, o) {}
 
-    const Box3& root() const { return root_; }
-    const std::vector<Node>& nodes() const { return nodes_; }
-    const std::vector<std::uint32_t>& refs() const { return refs_; }
+    /// The eight octants at the centre; none where the growth guard keeps the cell a leaf.
+    int split(const Box3& cell, int depth, const std::vector<std::uint32_t>& refs, const subdiv::Assigner& as,
+              Box3* kids, std::vector<std::uint8_t>& mask, std::array<std::size_t, 8>& counts) const;
+    void make_interior(Node& n, const Box3& cell, int depth, std::uint32_t first) const;
 
-    template <class C, Query Q>
-    bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        if (o_.locate) return o_.mailbox ? locate<C, Q, true>(ray, hit, counting) : locate<C, Q, false>(ray, hit, counting);
-        return o_.mailbox ? recursive<C, Q, true>(ray, hit, counting) : recursive<C, Q, false>(ray, hit, counting);
-    }
-
-protected:
-    StructureStats compute_structure() const override;
-    StructureStats compute_tree() const;
-    bool capped_ = false;  ///< the references or nodes bound stopped the build somewhere
-
-private:
-    void build(std::uint32_t node, const Box3& cell, int depth, std::vector<std::uint32_t>& refs,
-               const subdiv::Assigner& as);
-    void make_leaf(std::uint32_t node, const std::vector<std::uint32_t>& refs);
-
-    // A leaf's references through subdiv::test_leaf; true when an any-hit query may stop.
-    template <class C, Query Q, bool kMailbox>
-    bool test_leaf(const Node& n, int depth, const Ray& ray, Hit& hit, C& counting, spatial::Mailbox* mb,
-                   bool& found) const {
-        return subdiv::test_leaf<C, Q, kMailbox>(*scene_, refs_.data() + n.index, n.count, depth, ray, hit, counting,
-                                                 mb, found);
-    }
-
-    template <class C, Query Q, bool kMailbox>
-    bool locate(const Ray& ray, Hit& hit, C& counting) const {
-        counting.box();
-        const subdiv::CellRay r(ray);
-        float t, t_end;
-        if (!subdiv::clip_root(root_, r.ri, ray.tmin, ray.tmax, t, t_end)) return false;
-        spatial::Mailbox* mb = nullptr;
-        if constexpr (kMailbox) mb = &spatial::Mailbox::begin_ray(this, scene_->size());
-        const Node* nodes = nodes_.data();
-        bool found = false;
-        struct Item {
-            std::uint32_t node;
-            int depth;
-            float up;  // smallest crossing above t on the path so far: the cell's exit
-        };
-        // A descent branches only at planes the ray lies in (at most once per axis on a path).
-        Item stack[8 * (kMaxDepth + 2)];
-        for (;;) {
-            float exit = t_end;
-            int sp = 0;
-            stack[sp++] = {0, 0, t_end};
-            while (sp > 0) {
-                const Item it = stack[--sp];
-                const Node& n = nodes[it.node];
-                if (n.leaf()) {
-                    if (test_leaf<C, Q, kMailbox>(n, it.depth, ray, hit, counting, mb, found)) return true;
-                    exit = it.up < exit ? it.up : exit;
-                    continue;
-                }
-                counting.interior(it.depth);
-                unsigned bits = 0, both = 0;
-                float up = it.up;
-                for (int a = 0; a < 3; ++a) {
-                    counting.plane();
-                    const float s = n.center[a];
-                    if (r.moving[a]) {
-                        const float ts = r.cross(a, s);
-                        const bool high = r.high_after(a, ts, t);
-                        bits |= static_cast<unsigned>(high) << a;
-                        if (r.leaves(a, high) && ts < up) up = ts;
-                    } else if (r.ri.o[a] > s) {
-                        bits |= 1u << a;
-                    } else if (r.ri.o[a] == s) {
-                        both |= 1u << a;  // in the plane: both octants on this axis
-                    }
-                }
-                for (unsigned sub = both;; sub = (sub - 1) & both) {
-                    stack[sp++] = {n.index + (bits | sub), it.depth + 1, up};
-                    if (sub == 0) break;
-                }
+    template <class C, class Push>
+    void locate_children(const Node& n, const subdiv::CellRay& r, float t, float up, C& counting, Push push) const {
+        unsigned bits = 0, both = 0;
+        for (int a = 0; a < 3; ++a) {
+            counting.plane();
+            const float s = n.center[a];
+            if (r.moving[a]) {
+                const float ts = r.cross(a, s);
+                const bool high = r.high_after(a, ts, t);
+                bits |= static_cast<unsigned>(high) << a;
+                if (r.leaves(a, high) && ts < up) up = ts;
+            } else if (r.ri.o[a] > s) {
+                bits |= 1u << a;
+            } else if (r.ri.o[a] == s) {
+                both |= 1u << a;  // in the plane: both octants on this axis
             }
-            // A hit up to and including the exit lies in these cells: nothing later is nearer.
-            if constexpr (Q != Query::All) {
-                if (hit.t <= exit) return found;
-            }
-            if (exit >= t_end) return found;
-            t = exit;  // strictly greater than before: every exit bounds its cell from above
+        }
+        for (unsigned sub = both;; sub = (sub - 1) & both) {
+            push(n.index + (bits | sub), up);
+            if (sub == 0) break;
         }
     }
 
-    template <class C, Query Q, bool kMailbox>
-    bool recursive(const Ray& ray, Hit& hit, C& counting) const {
-        counting.box();
-        const subdiv::CellRay r(ray);
-        struct Entry {
-            std::uint32_t node;
-            float t0, t1;
-            int depth;
-            bool may_end;  // false beside a plane the ray lies in, until the other side is done
-        };
-        Entry e{0, 0, 0, 0, true};
-        if (!subdiv::clip_root(root_, r.ri, ray.tmin, ray.tmax, e.t0, e.t1)) return false;
-        spatial::Mailbox* mb = nullptr;
-        if constexpr (kMailbox) mb = &spatial::Mailbox::begin_ray(this, scene_->size());
-        const Node* nodes = nodes_.data();
-        bool found = false;
-        Entry stack[8 * (kMaxDepth + 2)];  // at most seven waiting children per level
-        int sp = 0;
-        for (;;) {
-            const Node& n = nodes[e.node];
-            if (n.leaf()) {
-                if (test_leaf<C, Q, kMailbox>(n, e.depth, ray, hit, counting, mb, found)) return true;
-                if constexpr (Q != Query::All) {
-                    if (e.may_end && hit.t <= e.t1) return found;
-                }
-                if (sp == 0) return found;
-                e = stack[--sp];
-                continue;
-            }
-            counting.interior(e.depth);
-            // The first child and the mid-plane crossings inside (t0, t1), by parameter only.
-            unsigned bits = 0, both = 0;
-            float xt[3];
-            unsigned xbit[3];
-            int nx = 0;
-            for (int a = 0; a < 3; ++a) {
-                counting.plane();
-                const float s = n.center[a];
-                if (r.moving[a]) {
-                    const float ts = r.cross(a, s);
-                    bits |= static_cast<unsigned>(r.high_after(a, ts, e.t0)) << a;
-                    if (e.t0 < ts && ts < e.t1) {
-                        // Insertion in ascending order (at most three).
-                        int j = nx++;
-                        for (; j > 0 && xt[j - 1] > ts; --j) {
-                            xt[j] = xt[j - 1];
-                            xbit[j] = xbit[j - 1];
-                        }
-                        xt[j] = ts;
-                        xbit[j] = 1u << a;
+    template <class C>
+    int recursive_children(const Node& n, const subdiv::CellRay& r, const subdiv::CellEntry& e, C& counting,
+                           subdiv::CellEntry* out) const {
+        // The first child and the mid-plane crossings inside (t0, t1), by parameter only.
+        unsigned bits = 0, both = 0;
+        float xt[3];
+        unsigned xbit[3];
+        int nx = 0;
+        for (int a = 0; a < 3; ++a) {
+            counting.plane();
+            const float s = n.center[a];
+            if (r.moving[a]) {
+                const float ts = r.cross(a, s);
+                bits |= static_cast<unsigned>(r.high_after(a, ts, e.t0)) << a;
+                if (e.t0 < ts && ts < e.t1) {
+                    // Insertion in ascending order (at most three).
+                    int j = nx++;
+                    for (; j > 0 && xt[j - 1] > ts; --j) {
+                        xt[j] = xt[j - 1];
+                        xbit[j] = xbit[j - 1];
                     }
-                } else if (r.ri.o[a] > s) {
-                    bits |= 1u << a;
-                } else if (r.ri.o[a] == s) {
-                    both |= 1u << a;
+                    xt[j] = ts;
+                    xbit[j] = 1u << a;
                 }
+            } else if (r.ri.o[a] > s) {
+                bits |= 1u << a;
+            } else if (r.ri.o[a] == s) {
+                both |= 1u << a;
             }
-            // The children in order along the ray: one per stretch between crossings (equal
-            // crossings, a corner, flip their bits together), times the octants beside planes the
-            // ray lies in, of which only the last may end the search.
-            Entry list[8];
-            int nl = 0;
-            const int depth = e.depth + 1;
-            float lo = e.t0;
-            for (int k = 0;;) {
-                const float hi = k < nx ? xt[k] : e.t1;
-                for (unsigned sub = both;; sub = (sub - 1) & both) {
-                    list[nl++] = {n.index + (bits | sub), lo, hi, depth, sub == 0 ? e.may_end : false};
-                    if (sub == 0) break;
-                }
-                if (k >= nx) break;
-                const float x = xt[k];
-                for (; k < nx && xt[k] == x; ++k) bits ^= xbit[k];
-                lo = x;
-            }
-            for (int k = nl - 1; k > 0; --k) stack[sp++] = list[k];
-            e = list[0];
         }
+        // The children in order along the ray: one per stretch between crossings (equal
+        // crossings, a corner, flip their bits together), times the octants beside planes the
+        // ray lies in, of which only the last may end the search.
+        int nl = 0;
+        const int depth = e.depth + 1;
+        float lo = e.t0;
+        for (int k = 0;;) {
+            const float hi = k < nx ? xt[k] : e.t1;
+            for (unsigned sub = both;; sub = (sub - 1) & both) {
+                out[nl++] = {n.index + (bits | sub), lo, hi, depth, sub == 0 ? e.may_end : false};
+                if (sub == 0) break;
+            }
+            if (k >= nx) break;
+            const float x = xt[k];
+            for (; k < nx && xt[k] == x; ++k) bits ^= xbit[k];
+            lo = x;
+        }
+        return nl;
     }
 
-    Options o_;
-    Box3 root_;
-    std::vector<Node> nodes_;
-    std::vector<std::uint32_t> refs_;
+    /// The model's binary tree: an octree node is three binary levels at its centre, X, then Y,
+    /// then Z. The X level carries the visit (one step, three plane compares); the Y and Z
+    /// levels only carry regions and planes for the probabilities (no step, no operations). A
+    /// Z-level node's children are the octants (x, y, 0) and (x, y, 1).
+    template <class Child>
+    void emit_interior(ModelSink& sink, const Node& n, const Box3& region, Child child) const {
+        ModelNode m;
+        m.region = region;
+        m.step = true;
+        m.leaf = false;
+        m.count = 2;
+        m.axis = 0;
+        m.split = n.center.x;
+        m.plane = 3;
+        sink.node(m, {});
+        for (int xi = 0; xi < 2; ++xi) {
+            ModelNode y;
+            y.region = subdiv::half(region, 0, n.center.x, xi);
+            y.leaf = false;
+            y.axis = 1;
+            y.split = n.center.y;
+            y.count = 2;
+            y.step = false;
+            sink.node(y, {});
+            for (int yi = 0; yi < 2; ++yi) {
+                ModelNode z;
+                z.region = subdiv::half(y.region, 1, n.center.y, yi);
+                z.leaf = false;
+                z.axis = 2;
+                z.split = n.center.z;
+                z.count = 2;
+                z.step = false;
+                sink.node(z, {});
+                for (int zi = 0; zi < 2; ++zi)
+                    child(n.index + static_cast<std::uint32_t>(xi | yi << 1 | zi << 2),
+                          subdiv::half(z.region, 2, n.center.z, zi));
+            }
+        }
+    }
 };
 
 }  // namespace rtcost::octree

@@ -21,14 +21,14 @@ std::vector<ParamSpec> specs(int default_depth, int max_depth, int default_prims
 // Builds with the model's split test (the test and the sample it reads live only during the
 // build) and with the yardstick's depth and leaf size (`usual_depth`, `usual_prims`), and keeps
 // the one the model predicts cheaper on the sample.
-template <class H, class O>
+template <class H>
 std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, double planes, const char* name,
                                  int usual_depth, int usual_prims) {
     const DesignInput in = draw_design_input(s, p);
     designing::CellRays cells(s, in, p.real("trust"), planes * in.costs.plane);
-    O o = subdiv::read_options<O>(p);
+    subdiv::CellOptions o = subdiv::read_options(p);
     o.name = name;
-    O usual = o;
+    subdiv::CellOptions usual = o;
     usual.max_depth = usual_depth;
     usual.max_prims = usual_prims;
     o.split_pays = [&cells](const Box3& cell, std::size_t n, const Box3* children, const std::size_t* counts, int k) {
@@ -42,7 +42,7 @@ const Registration octree_reg{
     {"octree-design", "Glassner's octree, a cell split only where the cost model with a sample of the given rays says it pays",
      specs(12, octree::kMaxDepth, 1),
      [](const Scene& s, const Params& p) {
-         return build<octree::Octree, octree::Options>(s, p, 3, "octree-design", 8, 1);
+         return build<octree::Octree>(s, p, 3, "octree-design", 8, 1);
      },
      kLargeScene}};  // every candidate split replayed on the sample: 10 s for a million triangles
 
@@ -50,7 +50,7 @@ const Registration bsp_reg{
     {"bsp-design", "Kaplan's BSP tree, a cell split only where the cost model with a sample of the given rays says it pays",
      specs(30, bsp::kMaxDepth, 1),
      [](const Scene& s, const Params& p) {
-         return build<bsp::Bsp, bsp::Options>(s, p, 1, "bsp-design", 20, 2);
+         return build<bsp::Bsp>(s, p, 1, "bsp-design", 20, 2);
      }}};
 
 }  // namespace

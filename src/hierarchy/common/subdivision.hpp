@@ -26,8 +26,8 @@
 #include <string>
 #include <vector>
 
-#include "../common/spatial.hpp"
-#include "../common/impl.hpp"
+#include "spatial.hpp"
+#include "impl.hpp"
 
 namespace rtcost::subdiv {
 
@@ -163,20 +163,8 @@ inline const ParamSpec kGrowthParam = ParamSpec::real(
 /// the cell a leaf (the designed hierarchies' cost model decides there).
 using SplitTest = std::function<bool(const Box3& cell, std::size_t n, const Box3* children, const std::size_t* counts, int k)>;
 
-/// The parameters `bsp` and `octree` share, with each one's defaults for depth and leaf size.
+/// The parameters `bsp` and `octree` share, with each one's defaults for depth and leaf size
+/// (read by cell_tree.hpp's read_options).
 std::vector<ParamSpec> param_specs(int default_depth, int max_depth, int default_prims);
-
-/// Reads those parameters into either's options.
-template <class O>
-O read_options(const Params& p) {
-    O o;
-    o.max_depth = static_cast<int>(p.integer("max_depth"));
-    o.max_prims = static_cast<int>(p.integer("max_prims"));
-    o.locate = p.is("traversal", "locate");
-    o.assign = spatial::parse_assign(p);
-    o.mailbox = p.flag("mailbox");
-    o.growth = p.real("growth");
-    return o;
-}
 
 }  // namespace rtcost::subdiv
