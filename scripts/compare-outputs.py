@@ -6,7 +6,7 @@ Usage: python3 scripts/compare-outputs.py BEFORE_RTCOST AFTER_RTCOST [--hits]
 
 The commands are the README's kinds of run on built-in scenes, small enough for a minute:
 `trace` of every registered hierarchy (counts per ray, hits), `eval` with each estimator
-(predicted and measured costs, ranks), `rays` of each distribution, `design`, `list`, and the
+(predicted and measured costs, ranks; the exact and the paper's presets), `rays` of each distribution, `design`, `list`, and the
 hit files of `trace --hits` (with --hits). Exits 1 and prints the first differences when any
 output differs; 0 when all agree.
 """
@@ -50,6 +50,10 @@ def commands(names):
     for est in ("geometric", "sampled", "segments"):
         cmds.append(["eval", scene, "-H", "bvh-sah,kd-sah,grid,octree,bsp,rc5d", "--rays", "camera", "--size", "32x32",
                      "--estimator", est, "--json", "-q"])
+    # The seed paper's formulas (the hierarchies declare what they charge) beside the exact ones.
+    for est in ("geometric", "sampled"):
+        cmds.append(["eval", scene, "-H", "bvh-sah,kd-sah,grid,octree,bsp,rc5d,brute", "--rays", "spd", "--size", "24x24",
+                     "--estimator", est, "--preset", "both", "--json", "-q"])
     for dist in ("camera", "spd", "shadow", "diffuse", "ao", "lines", "random", "aimed"):
         cmds.append(["rays", scene, "--rays", dist, "--size", "16x16", "--count", "500", "--json", "-q"])
     cmds.append(["design", scene, "--rays", "spd", "--size", "32x32", "--sample", "512", "--json", "-q"])

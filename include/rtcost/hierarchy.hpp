@@ -60,8 +60,8 @@ struct ModelNode {
     float beam_u[2] = {-1, 1}, beam_v[2] = {-1, 1};
 };
 
-/// A hierarchy's family, as the model tree declares it: the `paper` preset charges each
-/// family's nodes by the seed paper's formula for it.
+/// A hierarchy's family, as the model tree declares it (a label for its users: the model reads
+/// what a node costs from the tree, never from the family).
 enum class ModelFamily : std::uint8_t {
     Bvh,     ///< bounding volume hierarchies (and brute force, a one-leaf BVH)
     Bsp,     ///< Kaplan's BSP tree
@@ -71,11 +71,23 @@ enum class ModelFamily : std::uint8_t {
     Rc5d,    ///< Arvo and Kirk's 5D ray classification
 };
 
+/// What the seed paper's formula for a family (the `paper` preset) charges a node visit, as the
+/// hierarchy declares it: every node entered (a BVH's box test), every interior visit, and, for
+/// Kaplan's and Glassner's trees, the far region's entry 1_cmp + [g (1 - P_B) + (1 - g)] n_f
+/// in place of `interior_box` (g the share of visits that cross the plane, P_B the near child's
+/// chance to end the search).
+struct PaperCharges {
+    float entered_box = 0;
+    float interior_box = 0, interior_plane = 0, interior_hop = 0, interior_classify = 0;
+    bool far_entry = false;
+};
+
 /// The flags of a model tree: what the nodes alone do not say about the traversal.
 struct ModelFlags {
-    /// Every hierarchy names its family: there is no default to fall back on.
-    explicit ModelFlags(ModelFamily f) : family(f) {}
+    /// Every hierarchy names its family and the paper's charges: there is no default.
+    ModelFlags(ModelFamily f, PaperCharges p) : family(f), paper(p) {}
     ModelFamily family;
+    PaperCharges paper;
     /// Leaves are found by descending from the root for every cell (Kaplan's and Glassner's
     /// `locate` traversal): each leaf visit pays the operations of all its ancestors again.
     bool locate = false;
@@ -99,7 +111,7 @@ struct ModelFlags {
 /// (Goldsmith and Salmon's trees are n-ary), each entered through its own box test.
 struct ModelTree : ModelFlags {
     /// An empty tree (a hierarchy the model cannot see into); emit_model's flags replace these.
-    ModelTree() : ModelFlags(ModelFamily::Bvh) {}
+    ModelTree() : ModelFlags(ModelFamily::Bvh, {.entered_box = 1}) {}
     std::vector<ModelNode> nodes;
     std::vector<std::uint32_t> prims;  ///< leaf primitive references
 };

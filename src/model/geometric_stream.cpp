@@ -284,7 +284,7 @@ private:
         const ModelNode& m = o.m;
         const double times = flags_.locate && !m.leaf ? S.leaf_visits : p;
         const double gated = flags_.locate && !m.leaf ? times : pg;
-        charge_visit(S.c, m, flags_.family, paper_, times, gated, 0.5, pb);
+        charge_visit(S.c, m, paper_ ? &flags_.paper : nullptr, times, gated, 0.5, pb);
         if (m.step) {
             S.c.steps += times;
             S.add_depth(o.tdepth, times);
@@ -293,7 +293,7 @@ private:
 
     const Scene& scene_;
     ModelOptions opt_;
-    ModelFlags flags_{ModelFamily::Bvh};  // begin() sets the tree's own
+    ModelFlags flags_{ModelFamily::Bvh, {.entered_box = 1}};  // begin() sets the tree's own
     bool paper_ = false, terminate_ = false, begun_ = false, done_ = false;
     std::span<const PrimSummary> sums_;
     std::vector<PrimSummary> own_sums_;

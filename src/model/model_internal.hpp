@@ -87,9 +87,10 @@ struct Walk {
 inline bool terminates(const ModelFlags& f, Query q) { return q == Query::Any || (q == Query::Closest && f.cull); }
 
 /// Adds the operations of one visit of `m` to `c`, scaled by `p` (visits) and `pg` (visits that
-/// pass the node's bounding volume). `gamma` and `pb` (P of the first child, 0 without
-/// termination) enter the paper's Kaplan/Glassner term only.
-void charge_visit(CostVector& c, const ModelNode& m, ModelFamily f, bool paper, double p, double pg, double gamma,
+/// pass the node's bounding volume): the node's own, or the tree's declared `paper` charges
+/// (null: the exact preset). `gamma` and `pb` (P of the first child, 0 without termination)
+/// enter the Kaplan/Glassner far-entry term only.
+void charge_visit(CostVector& c, const ModelNode& m, const PaperCharges* paper, double p, double pg, double gamma,
                   double pb);
 
 /// The recursion: q(child | parent visited) for every node from per-node probabilities (the

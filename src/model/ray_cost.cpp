@@ -25,7 +25,7 @@ struct RayCostModel::Impl {
     double p_end(std::uint32_t x) const { return prob[x].p_first >= 0 ? prob[x].p_first : prob[x].p_hit; }
 
     void charge(CostVector& c, const ModelNode& m, double p, double pg) const {
-        charge_visit(c, m, tree.family, false, p, pg, 0.5, 0.0);
+        charge_visit(c, m, nullptr, p, pg, 0.5, 0.0);
         if (m.step) c.steps += p;
     }
 

@@ -7,9 +7,10 @@
 namespace rtcost::model {
 
 /// Adds the operations of one visit of `m` to `c`, scaled by `p` (visits) and `pg` (visits that
-/// pass the node's bounding volume). `gamma` and `pb` (P of the first child, 0 without
-/// termination) enter the paper's Kaplan/Glassner term only.
-void charge_visit(CostVector& c, const ModelNode& m, ModelFamily f, bool paper, double p, double pg, double gamma,
+/// pass the node's bounding volume): the node's own operations, or with `paper` the charges the
+/// hierarchy declared for the paper's formula. `gamma` and `pb` (P of the first child, 0 without
+/// termination) enter the Kaplan/Glassner far-entry term only.
+void charge_visit(CostVector& c, const ModelNode& m, const PaperCharges* paper, double p, double pg, double gamma,
                   double pb) {
     if (!paper) {
         c.box += p * m.box;
@@ -18,27 +19,12 @@ void charge_visit(CostVector& c, const ModelNode& m, ModelFamily f, bool paper, 
         c.classify += pg * m.classify;
         return;
     }
-    if (f == ModelFamily::Bvh) {
-        c.box += p;  // the paper charges a node's own box test when it is entered
-        return;
-    }
+    c.box += p * paper->entered_box;
     if (m.leaf) return;
-    // No default: a new family must say which formula charges its interior nodes.
-    switch (f) {
-        case ModelFamily::Bvh: break;
-        case ModelFamily::Grid: c.hop += p; break;
-        case ModelFamily::Rc5d: c.classify += p; break;
-        case ModelFamily::Kd:
-            c.plane += p;
-            c.box += p;
-            break;
-        case ModelFamily::Bsp:
-        case ModelFamily::Octree:
-            // Kaplan/Glassner: 1_cmp + [g (1 - P_B) + (1 - g)] n_f, the far region's entry.
-            c.plane += p;
-            c.box += p * (gamma * (1 - pb) + (1 - gamma));
-            break;
-    }
+    c.plane += p * paper->interior_plane;
+    c.hop += p * paper->interior_hop;
+    c.classify += p * paper->interior_classify;
+    c.box += p * (paper->far_entry ? gamma * (1 - pb) + (1 - gamma) : paper->interior_box);
 }
 
 /// The sampled estimator's recursion: q(child | parent visited) for every node from per-node
@@ -58,7 +44,7 @@ Prediction recurse(const ModelTree& t, const Walk& w, const std::vector<NodeProb
     };
     auto charge = [&](const ModelNode& m, double p, double pg, std::size_t i) {
         const double pb = paper && terminate && !m.leaf ? prob[m.first].p_hit : 0.0;
-        charge_visit(c, m, t.family, paper, p, pg, prob[i].gamma, pb);
+        charge_visit(c, m, paper ? &t.paper : nullptr, p, pg, prob[i].gamma, pb);
     };
 
     // Primitive kinds: scenes of one kind (most meshes) need no look-up per reference; an array

@@ -26,7 +26,7 @@ public:
 
     /// One leaf holding every primitive, entered with no box test.
     bool emit_model(ModelSink& sink) const override {
-        ModelFlags f(ModelFamily::Bvh);
+        ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
         f.per_ray_box = 0;
         f.gated = false;  // a ray that misses the scene's box still tests every primitive
         if (!sink.begin(f)) return true;

@@ -237,7 +237,7 @@ StructureStats BvhWide::compute_structure() const {
 }
 
 bool BvhWide::emit_model(ModelSink& sink) const {
-    ModelFlags f(ModelFamily::Bvh);
+    ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     if (!sink.begin(f) || d_->root_count == 0) return true;
     ModelNode root;
     root.region = root.bv = d_->root_box;

@@ -24,7 +24,7 @@ StructureStats Bvh::compute_structure() const {
 }
 
 bool Bvh::emit_model(ModelSink& sink) const {
-    ModelFlags f(ModelFamily::Bvh);
+    ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     f.cull = ordered_;
     if (!sink.begin(f) || d_.nodes.empty()) return true;
     auto emit = [&](auto&& self, std::uint32_t i) -> void {

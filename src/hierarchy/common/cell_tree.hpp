@@ -249,7 +249,8 @@ StructureStats CellTree<Derived, NodeT>::compute_structure() const {
 // and with `locate` the model charges every leaf visit its whole descent again.
 template <class Derived, class NodeT>
 bool CellTree<Derived, NodeT>::emit_model(ModelSink& sink) const {
-    ModelFlags f(Derived::kModelFamily);
+    // The paper's Kaplan/Glassner term: a plane compare and the far region's entry.
+    ModelFlags f(Derived::kModelFamily, {.interior_plane = 1, .far_entry = true});
     f.locate = o_.locate;
     f.per_ray_box = 1;
     if (!sink.begin(f) || nodes_.empty()) return true;

@@ -237,7 +237,7 @@ StructureStats Grid::compute_structure() const {
 // interior(0). Each cell visit is a step and costs one hop; per_entry_hop = -1 because the
 // first cell is reached without one.
 bool Grid::emit_model(ModelSink& sink) const {
-    ModelFlags f(ModelFamily::Grid);
+    ModelFlags f(ModelFamily::Grid, {.interior_hop = 1});  // the paper: one hop per cell
     f.per_ray_box = 1;
     f.per_entry_hop = -1;
     if (!sink.begin(f)) return true;

@@ -115,7 +115,7 @@ StructureStats KdTree::compute_structure() const {
 // node boxes one box test first (the model's gate: the plane is paid only when the box is met).
 // Leaves have no box. The root clip is per_ray_box.
 bool KdTree::emit_model(ModelSink& sink) const {
-    ModelFlags f(ModelFamily::Kd);
+    ModelFlags f(ModelFamily::Kd, {.interior_box = 1, .interior_plane = 1});  // the paper's kd node
     f.per_ray_box = 1;
     if (!sink.begin(f) || d_.nodes.empty()) return true;
     auto emit = [&](auto&& self, std::uint32_t i, const Box3& region) -> void {

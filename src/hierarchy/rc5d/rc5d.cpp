@@ -220,7 +220,7 @@ StructureStats Rc5d::compute_structure() const {
 // plane that a ray crosses: a ray goes to exactly one child. The split dimension of a node at
 // model depth d >= 1 is (d - 1) % 5 (x, y, z, u, v). Pending beams appear as leaves.
 bool Rc5d::emit_model(ModelSink& sink) const {
-    ModelFlags f(ModelFamily::Rc5d);
+    ModelFlags f(ModelFamily::Rc5d, {.interior_classify = 1});  // the paper: one classification per level
     f.per_ray_box = 1;
     f.per_entry_hop = 0;
     f.one_path = true;
