@@ -17,6 +17,7 @@
 #include <string_view>
 #include <vector>
 
+#include "rtcost/model_tree.hpp"
 #include "rtcost/scene.hpp"
 #include "rtcost/stats.hpp"
 
@@ -28,112 +29,6 @@ enum class Query {
     Any,      ///< any hit in (tmin, tmax) (occlusion); the hit reported is the first one found
     All,      ///< visit everything the segment meets, never stop early; reports the closest hit
 };
-
-/// One node of a hierarchy as the cost model sees it (see the cost-model docs): a region, an
-/// optional bounding volume tested before the node is entered, an optional separating plane, the
-/// operations one visit costs, and either children or the primitives of a leaf.
-struct ModelNode {
-    Box3 region;                 ///< R(A): the node's box (a BVH node's bounding box)
-    bool has_bv = false;         ///< a box test against `bv` precedes entering the node's children
-    Box3 bv;                     ///< the bounding volume tested (BVH: equals `region`)
-    std::int8_t axis = -1;       ///< separating plane axis, -1 for none (BVH)
-    float split = 0;             ///< separating plane position on `axis`
-    std::uint32_t first = 0;     ///< first child (in ModelTree::nodes) or first primitive (in ModelTree::prims)
-    std::uint32_t count = 0;     ///< number of children, or of primitives for a leaf
-    bool leaf = true;
-    int depth = 0;               ///< root at 0 (in model-tree levels)
-    /// Operations one visit of this node performs besides primitive tests, in counter units
-    /// (e.g. a kd-median node: one box and one plane; an octree's three binary levels: the
-    /// first carries the visit, the other two none).
-    float box = 0, plane = 0, hop = 0, classify = 0;
-    bool step = true;            ///< a visit is one traversal step (N_TS)
-    /// A subtree left out of a tree materialised for a ray sample (reached_model_tree): no
-    /// segment of the sample meets it, so the node stands for it as an empty leaf.
-    bool pruned = false;
-    /// 5D ray classification: the node is a set of rays, `region` its origin box and these its
-    /// directions: dominant axis `beam_axis` (-1: not a beam) and sign, u and v ranges (the other
-    /// two direction components over |d[beam_axis]|, lower axis first). Children split one of
-    /// the five dimensions at `split`: `beam_dim` 0..2 origin, 3 u, 4 v.
-    std::int8_t beam_axis = -1;
-    bool beam_negative = false;
-    std::int8_t beam_dim = -1;
-    float beam_u[2] = {-1, 1}, beam_v[2] = {-1, 1};
-};
-
-/// A hierarchy's family, as the model tree declares it (a label for its users: the model reads
-/// what a node costs from the tree, never from the family).
-enum class ModelFamily : std::uint8_t {
-    Bvh,     ///< bounding volume hierarchies (and brute force, a one-leaf BVH)
-    Bsp,     ///< Kaplan's BSP tree
-    Octree,  ///< Glassner's octree
-    Kd,      ///< kd-trees
-    Grid,    ///< uniform grids
-    Rc5d,    ///< Arvo and Kirk's 5D ray classification
-};
-
-/// What the seed paper's formula for a family (the `paper` preset) charges a node visit, as the
-/// hierarchy declares it: every node entered (a BVH's box test), every interior visit, and, for
-/// Kaplan's and Glassner's trees, the far region's entry 1_cmp + [g (1 - P_B) + (1 - g)] n_f
-/// in place of `interior_box` (g the share of visits that cross the plane, P_B the near child's
-/// chance to end the search).
-struct PaperCharges {
-    float entered_box = 0;
-    float interior_box = 0, interior_plane = 0, interior_hop = 0, interior_classify = 0;
-    bool far_entry = false;
-};
-
-/// The flags of a model tree: what the nodes alone do not say about the traversal.
-struct ModelFlags {
-    /// Every hierarchy names its family and the paper's charges: there is no default.
-    ModelFlags(ModelFamily f, PaperCharges p) : family(f), paper(p) {}
-    ModelFamily family;
-    PaperCharges paper;
-    /// Leaves are found by descending from the root for every cell (Kaplan's and Glassner's
-    /// `locate` traversal): each leaf visit pays the operations of all its ancestors again.
-    bool locate = false;
-    /// Operations every ray pays once whatever it meets (e.g. the root box test), and those a
-    /// ray that enters the root pays once more or less (a grid's first cell has no hop: -1).
-    float per_ray_box = 1, per_entry_hop = 0;
-    /// A ray follows exactly one root-to-leaf path (5D classification: the children of a node
-    /// are disjoint sets of rays), whose leaf candidates are searched in order of their start
-    /// along the dominant axis and the search stops early.
-    bool one_path = false;
-    /// A closest-hit query skips what lies beyond the nearest hit found so far (false: the
-    /// traversal visits everything the segment meets, e.g. a BVH with `order=none`).
-    bool cull = true;
-    /// A ray that misses the root's region ends at the root test (false: every ray enters the
-    /// root whatever it meets, as brute force's does).
-    bool gated = true;
-};
-
-/// A hierarchy flattened for the model: `nodes[0]` is the root; the children of a node are
-/// contiguous. Binary for space subdivisions; a BVH node may have more than two children
-/// (Goldsmith and Salmon's trees are n-ary), each entered through its own box test.
-struct ModelTree : ModelFlags {
-    /// An empty tree (a hierarchy the model cannot see into); emit_model's flags replace these.
-    ModelTree() : ModelFlags(ModelFamily::Bvh, {.entered_box = 1}) {}
-    std::vector<ModelNode> nodes;
-    std::vector<std::uint32_t> prims;  ///< leaf primitive references
-};
-
-/// Receives a hierarchy's model tree depth first (Hierarchy::emit_model), so that the model
-/// can read a hierarchy of millions of nodes where it lies instead of copying it: `begin` once,
-/// then `node` for every node in pre-order, a node with `count` children being followed by its
-/// children's whole subtrees, in order.
-class ModelSink {
-public:
-    virtual ~ModelSink() = default;
-    /// The tree's flags, before its root. Returning false ends the emission there (a sink that
-    /// only asks whether there is a model tree).
-    virtual bool begin(const ModelFlags& flags) = 0;
-    /// One node. `m.first` and `m.depth` are not read (the order says them); a leaf's
-    /// primitive ids are `prims`, `m.count` of them.
-    virtual void node(const ModelNode& m, std::span<const std::uint32_t> prims) = 0;
-};
-
-/// Emits a materialised model tree into `sink`, depth first (what Hierarchy::emit_model does
-/// for a hierarchy).
-void emit_model(const ModelTree& tree, ModelSink& sink);
 
 /// What values a build parameter takes. One declaration serves `rtcost list` (which prints
 /// it), Params (which checks every value against it before a build starts) and a search over

@@ -31,11 +31,11 @@ public:
 
 void emit_subtree(const ModelTree& t, std::uint32_t i, ModelSink& sink) {
     const ModelNode& m = t.nodes[i];
-    if (m.leaf) {
-        sink.node(m, std::span<const std::uint32_t>(t.prims).subspan(m.first, m.count));
-        return;
-    }
-    sink.node(m, {});
+    const std::span<const std::uint32_t> prims =
+        m.leaf ? std::span<const std::uint32_t>(t.prims).subspan(m.first, m.count) : std::span<const std::uint32_t>{};
+    if (i < t.beams.size()) sink.beam_node(m, t.beams[i], prims);
+    else sink.node(m, prims);
+    if (m.leaf) return;
     for (std::uint32_t k = 0; k < m.count; ++k) emit_subtree(t, m.first + k, sink);
 }
 

@@ -46,12 +46,11 @@ double gauss_2d(double u0, double u1, double v0, double v1, int which, double si
 
 }  // namespace
 
-/// Line-measure weight of a beam whose origins lie in `o` (inside root box `b`).
-double beam_weight(const ModelNode& m, const Box3& b) {
-    const int k = m.beam_axis;
+/// Line-measure weight of a beam with directions `m` whose origins lie in `o` (inside root box `b`).
+double beam_weight(const ModelBeam& m, const Box3& o, const Box3& b) {
+    const int k = m.axis;
     const int i1 = k == 0 ? 1 : 0;  // the other axis carries v
-    const double s = m.beam_negative ? -1.0 : 1.0;
-    const Box3& o = m.region;
+    const double s = m.negative ? -1.0 : 1.0;
     double total = 0;
     for (int a = 0; a < 3; ++a) {
         const int p = (a + 1) % 3, q = (a + 2) % 3;
@@ -62,9 +61,9 @@ double beam_weight(const ModelNode& m, const Box3& b) {
             if (!touches || area <= 0) continue;
             const double dir = side == 0 ? 1.0 : -1.0;
             double integral;
-            if (a == k) integral = s * dir > 0 ? gauss_2d(m.beam_u[0], m.beam_u[1], m.beam_v[0], m.beam_v[1], 0, 1) : 0;
-            else if (a == i1) integral = gauss_2d(m.beam_u[0], m.beam_u[1], m.beam_v[0], m.beam_v[1], 1, dir);
-            else integral = gauss_2d(m.beam_u[0], m.beam_u[1], m.beam_v[0], m.beam_v[1], 2, dir);
+            if (a == k) integral = s * dir > 0 ? gauss_2d(m.u[0], m.u[1], m.v[0], m.v[1], 0, 1) : 0;
+            else if (a == i1) integral = gauss_2d(m.u[0], m.u[1], m.v[0], m.v[1], 1, dir);
+            else integral = gauss_2d(m.u[0], m.u[1], m.v[0], m.v[1], 2, dir);
             total += area * integral;
         }
     }

@@ -38,6 +38,11 @@ public:
         return true;
     }
 
+    void beam_node(const ModelNode& m, const ModelBeam& beam, std::span<const std::uint32_t> prims) override {
+        beam_ = beam;  // read when the node is finished: a leaf at once
+        node(m, prims);
+    }
+
     void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
         Box3 visit = m.region;
         int tdepth = 0;
@@ -248,7 +253,7 @@ private:
         S.reset(o.tdepth);
         double weight = 0;
         if (m.leaf) {
-            weight = beam_weight(m, root_region_);
+            weight = beam_weight(beam_, m.region, root_region_);
             // Ordered search: candidate j is tested unless an earlier one ended the search; each
             // earlier candidate is hit with p = its Crofton area over the surface of the box
             // around the leaf's candidates (an approximation: independence, no occlusion order).
@@ -294,6 +299,7 @@ private:
     const Scene& scene_;
     ModelOptions opt_;
     ModelFlags flags_{ModelFamily::Bvh, {.entered_box = 1}};  // begin() sets the tree's own
+    ModelBeam beam_;  // the directions of the last 5D node emitted
     bool paper_ = false, terminate_ = false, begun_ = false, done_ = false;
     std::span<const PrimSummary> sums_;
     std::vector<PrimSummary> own_sums_;

@@ -103,8 +103,8 @@ Prediction recurse(const ModelTree& t, const Walk& w, const std::vector<NodeProb
 void scale_to_share(Prediction& p, const ModelTree& t, double share, const UnitCosts& costs);
 
 // ---- 5D ray classification (beams.cpp)
-/// Line-measure weight of a beam whose origins lie in `m.region` (inside root box `b`).
-double beam_weight(const ModelNode& m, const Box3& b);
+/// Line-measure weight of a beam with directions `m` whose origins lie in `o` (inside root box `b`).
+double beam_weight(const ModelBeam& m, const Box3& o, const Box3& b);
 /// Forward start of a primitive along a beam's dominant axis (its bounding box's near face).
 inline double forward_start(const Box3& pb, int k, bool negative) {
     return negative ? -double(pb.hi[k]) : double(pb.lo[k]);

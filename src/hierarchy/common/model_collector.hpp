@@ -23,11 +23,30 @@ public:
         return true;
     }
 
-    void node(const ModelNode& m, std::span<const std::uint32_t> prims) final {
+    void node(const ModelNode& m, std::span<const std::uint32_t> prims) final { place(m, prims); }
+
+    void beam_node(const ModelNode& m, const ModelBeam& beam, std::span<const std::uint32_t> prims) final {
+        const std::uint32_t at = place(m, prims);
+        if (at == kDropped) return;
+        if (t_.beams.size() < t_.nodes.size()) t_.beams.resize(t_.nodes.size());
+        t_.beams[at] = beam;
+    }
+
+protected:
+    /// Whether the node arriving at `depth` (root 0) keeps its subtree; asked in pre-order.
+    virtual bool keep(const ModelNode&, int) { return true; }
+
+    ModelTree& t_;
+
+private:
+    static constexpr std::uint32_t kDropped = ~0u;
+
+    // Stores `m` in its slot and returns the slot (kDropped inside a dropped subtree).
+    std::uint32_t place(const ModelNode& m, std::span<const std::uint32_t> prims) {
         if (skip_ > 0) {  // inside a dropped subtree
             --skip_;
             if (!m.leaf) skip_ += m.count;
-            return;
+            return kDropped;
         }
         std::uint32_t at = 0;
         int depth = 0;
@@ -57,15 +76,9 @@ public:
             if (m.count > 0) open_.push_back({n.first, n.first + m.count, depth + 1});
             t_.nodes.resize(t_.nodes.size() + m.count);  // invalidates `n`
         }
+        return at;
     }
 
-protected:
-    /// Whether the node arriving at `depth` (root 0) keeps its subtree; asked in pre-order.
-    virtual bool keep(const ModelNode&, int) { return true; }
-
-    ModelTree& t_;
-
-private:
     struct Slots {
         std::uint32_t next, end;
         int depth;

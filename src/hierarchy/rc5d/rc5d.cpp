@@ -230,12 +230,13 @@ bool Rc5d::emit_model(ModelSink& sink) const {
     root.leaf = false;
     root.count = 6;
     root.classify = 3;
-    sink.node(root, {});
-    // `m` arrives with the beam's region and directions; the node decides leaf or split.
-    auto emit = [&](auto&& self, const Node& n, const Cell& cell, int level, ModelNode m) -> void {
+    sink.beam_node(root, ModelBeam{}, {});
+    // `m` arrives with the beam's origin box, `b` with its directions; the node decides leaf or
+    // split.
+    auto emit = [&](auto&& self, const Node& n, const Cell& cell, int level, ModelNode m, const ModelBeam& b) -> void {
         if (n.state.load(std::memory_order_acquire) != kInterior) {
             m.count = n.count;
-            sink.node(m, std::span<const std::uint32_t>(n.refs.get(), n.count));
+            sink.beam_node(m, b, std::span<const std::uint32_t>(n.refs.get(), n.count));
             return;
         }
         const int dim = level % 5;
@@ -244,26 +245,26 @@ bool Rc5d::emit_model(ModelSink& sink) const {
         m.count = 2;
         m.beam_dim = static_cast<std::int8_t>(dim);
         m.split = n.split;
-        sink.node(m, {});
+        sink.beam_node(m, b, {});
         for (int side = 0; side < 2; ++side) {
             const Cell c = child_cell(cell, dim, n.split, side);
             ModelNode k;
             k.region = c.origin_box();
-            k.beam_axis = m.beam_axis;
-            k.beam_negative = m.beam_negative;
-            k.beam_u[0] = c.lo[3];
-            k.beam_u[1] = c.hi[3];
-            k.beam_v[0] = c.lo[4];
-            k.beam_v[1] = c.hi[4];
-            self(self, n.kids[side], c, level + 1, k);
+            ModelBeam kb = b;
+            kb.u[0] = c.lo[3];
+            kb.u[1] = c.hi[3];
+            kb.v[0] = c.lo[4];
+            kb.v[1] = c.hi[4];
+            self(self, n.kids[side], c, level + 1, k, kb);
         }
     };
     for (int c = 0; c < 6; ++c) {
         ModelNode m;
         m.region = root_.origin_box();
-        m.beam_axis = static_cast<std::int8_t>(c / 2);
-        m.beam_negative = c % 2 == 1;
-        emit(emit, cubes_[c], root_, 0, m);
+        ModelBeam b;
+        b.axis = static_cast<std::int8_t>(c / 2);
+        b.negative = c % 2 == 1;
+        emit(emit, cubes_[c], root_, 0, m, b);
     }
     return true;
 }
