@@ -2,7 +2,8 @@
 // Embree on the same scenes and the same rays, and the geometric estimator against tracing the
 // `spd` rays. Run: build/bench/rtcost_bench [--benchmark_filter=...]; docs/benchmarks.md says how.
 // Scenes come from ../shared/scenes/spd when present (RTCOST_SHARED overrides), else built-ins;
-// meshes from RTCOST_BENCH_MESHES (default build/meshes), written by scripts/tessellate.py.
+// meshes from RTCOST_BENCH_MESHES (default build/meshes), written by scripts/tessellate.py;
+// RTCOST_BENCH_VIEW sets one scene's camera and light (an earlier run's view, below).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -50,6 +51,18 @@ Workload& workload(const std::string& name) {
     if (!w) {
         w = std::make_unique<Workload>();
         w->scene = load_scene(scene_path(name));
+        // RTCOST_BENCH_VIEW="SCENE|fx,fy,fz,ax,ay,az,ux,uy,uz,fov|x,y,z": another camera and light for
+        // one scene (as rtcost's --camera and --light), e.g. the mesh camera of an earlier run.
+        if (const char* env = std::getenv("RTCOST_BENCH_VIEW")) {
+            const std::string v = env;
+            const std::size_t a = v.find('|'), b = v.find('|', a + 1);
+            if (a != std::string::npos && b != std::string::npos && v.substr(0, a) == name) {
+                ViewSpec view;
+                view.camera = v.substr(a + 1, b - a - 1);
+                view.lights.push_back(v.substr(b + 1));
+                apply_view(w->scene, view);
+            }
+        }
     }
     return *w;
 }

@@ -91,6 +91,10 @@ struct ModelFlags {
     /// A ray that misses the root's region ends at the root test (false: every ray enters the
     /// root whatever it meets, as brute force's does).
     bool gated = true;
+    /// An any-hit query visits the children it meets leaf children first (only a leaf can end
+    /// it), nearest entry first within leaves and within interior nodes, a tie to the later
+    /// child (bvh-wide's `any_order=leaves`); false: as a closest-hit query orders them.
+    bool any_leaves_first = false;
 };
 
 /// A hierarchy flattened for the model: `nodes[0]` is the root; the children of a node are

@@ -202,7 +202,11 @@ private:
                 ty.both += 1;
                 // Nearer entry first, a tie (a ray starting inside both) to the first child; a
                 // BVH without order: stored order.
-                const bool left_first = !t_.cull || sl.t0 <= sr.t0;
+                bool left_first = !t_.cull || sl.t0 <= sr.t0;
+                if (any_ && t_.any_leaves_first) {
+                    const bool ll = t_.nodes[m.first].leaf, lr = t_.nodes[m.first + 1].leaf;
+                    left_first = ll != lr ? ll : sl.t0 < sr.t0;
+                }
                 ty.left_first += left_first;
                 const std::uint32_t near = left_first ? m.first : m.first + 1;
                 const Segment& far = left_first ? sr : sl;
@@ -227,7 +231,13 @@ private:
                 if (!sc.empty()) met[nm++] = {sc.t0, m.first + k};
             }
             // Ties (a ray starting inside several) go to the later child, as the traversal's sort does.
-            if (t_.cull)
+            if (any_ && t_.any_leaves_first)
+                std::sort(met.begin(), met.begin() + nm, [&](auto& a, auto& b) {
+                    const bool la = t_.nodes[a.second].leaf, lb = t_.nodes[b.second].leaf;
+                    if (la != lb) return la;
+                    return a.first < b.first || (a.first == b.first && a.second > b.second);
+                });
+            else if (t_.cull)
                 std::sort(met.begin(), met.begin() + nm,
                           [](auto& a, auto& b) { return a.first < b.first || (a.first == b.first && a.second > b.second); });
             for (std::size_t k = 0; k < nm && !done(); ++k) {

@@ -19,6 +19,7 @@ struct RayCostModel::Impl {
     std::vector<NodeProbabilities> prob;
     std::vector<int> parent;
     bool terminate = false;
+    bool any_query = false;  // an any-hit query (its own child order where the tree declares one)
 
     // P that the search has ended in node x, where the recursion uses it: first of two met
     // (p_first), else of all its visits (p_hit).
@@ -67,7 +68,13 @@ struct RayCostModel::Impl {
             segs[k] = sc;
             met[nm++] = {sc.t0, k};
         }
-        if (tree.cull) {
+        if (any_query && tree.any_leaves_first) {
+            std::sort(met.begin(), met.begin() + nm, [&](auto& a, auto& b) {
+                const bool la = tree.nodes[m.first + a.second].leaf, lb = tree.nodes[m.first + b.second].leaf;
+                if (la != lb) return la;
+                return a.first < b.first || (a.first == b.first && a.second > b.second);
+            });
+        } else if (tree.cull) {
             if (m.count == 2)
                 std::stable_sort(met.begin(), met.begin() + nm, [](auto& a, auto& b) { return a.first < b.first; });
             else
@@ -90,6 +97,7 @@ RayCostModel::RayCostModel(ModelTree tree, const Scene& scene, const RaySample& 
     const Walk w(tree);
     impl->parent = w.parent;
     impl->terminate = terminates(tree, opt.query);
+    impl->any_query = opt.query == Query::Any;
     impl->tree = std::move(tree);
     impl->scene = &scene;
     for (const ModelNode& m : impl->tree.nodes)

@@ -14,6 +14,7 @@ struct BvhWide::Data {
     Box3 root_box;
     std::uint32_t root_count = 0;
     int tri_lanes = 4;
+    int any_order = kAnyNearest;
     struct alignas(kLeafAlign) Block {
         std::byte b[kLeafAlign];
     };
@@ -212,6 +213,7 @@ BvhWide::BvhWide(const Scene& s, std::unique_ptr<Data> d, Walks walks)
     view_.leaves = reinterpret_cast<const std::byte*>(d_->leaves.data());
     view_.tri_lanes = d_->tri_lanes;
     view_.scene = &s;
+    view_.any_order = d_->any_order;
 }
 
 BvhWide::~BvhWide() = default;
@@ -238,6 +240,7 @@ StructureStats BvhWide::compute_structure() const {
 
 bool BvhWide::emit_model(ModelSink& sink) const {
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
+    f.any_leaves_first = d_->any_order == kAnyLeaves;
     if (!sink.begin(f) || d_->root_count == 0) return true;
     ModelNode root;
     root.region = root.bv = d_->root_box;
@@ -293,6 +296,8 @@ std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p) {
         d->root_count = d->width == 8 ? collapse<8>(bd, d->n8) : collapse<4>(bd, d->n4);
     }
     d->tri_lanes = use_avx2 ? 8 : 4;
+    const std::string& ao = p.str("any_order");
+    d->any_order = ao == "nearest" ? kAnyNearest : kAnyLeaves;
     if (d->width == 8) {
         if (d->tri_lanes == 8) pack_leaves<8, 8>(*d, d->n8, bd, s);
         else pack_leaves<8, 4>(*d, d->n8, bd, s);
@@ -311,6 +316,9 @@ const Registration reg{
                         "children per node: 4, 8, or auto (8 where the CPU runs AVX2, else 4)"),
       ParamSpec::choice("simd", "auto", {"auto", "baseline", "avx2"},
                         "instruction set of the traversal: auto, baseline (SSE2) or avx2"),
+      ParamSpec::choice("any_order", "leaves", {"leaves", "nearest"},
+                        "order of the children met in any-hit (occlusion) queries: leaf children first, then "
+                        "nearest first; or nearest first, as closest-hit queries"),
       ParamSpec::integer("max_prims", "16", 1, 64, "largest leaf of the SAH tree collapsed (bigger nodes are always split)"),
       ParamSpec::integer("bins", "16", 2, 256, "SAH bins per axis"),
       ParamSpec::real("c_trav", "4", 0, 1e6,
@@ -319,6 +327,7 @@ const Registration reg{
      build},
     {{{}, kTestHits | kTestSampled},
      {{"width=4"}, kTestHits | kTestSampled},
+     {{"any_order=nearest"}, kTestHits | kTestSampled},
      {{"width=8", "simd=baseline", "max_prims=1"}, kTestHits},
      {{"width=4", "simd=baseline", "max_prims=8"}, kTestHits}}};
 
