@@ -1,8 +1,10 @@
 // `bvh-design`: a binned BVH builder whose split cost takes each child's visit probability from
 // the design sample (the share of the node's sample segments, clipped where each ray's search
 // ends, that meet the child's box), blended with the surface-area ratio where few segments reach
-// the node; a node stays a leaf where no split pays; and per node the order in which occlusion
-// rays enter its children (occlusion_order.hpp). Otherwise traversed as every BVH (../bvh/bvh.hpp).
+// the node; a node stays a leaf where no split pays; and the order in which occlusion rays enter
+// a node's children: front to back or leaf children first, whichever the model predicts cheaper
+// on the sample (or, with occlusion=sample, an order bit per node: occlusion_order.hpp).
+// Otherwise traversed as every BVH (../bvh/bvh.hpp).
 #include <algorithm>
 #include <unordered_map>
 
@@ -11,7 +13,6 @@
 #include "../bvh/topdown.hpp"
 #include "occlusion_order.hpp"
 #include "rtcost/design.hpp"
-#include "design/cheaper.hpp"
 
 namespace rtcost::bvh {
 namespace {
@@ -227,10 +228,11 @@ const Registration reg{
          p.push_back(ParamSpec::integer("candidates", "8", 1, 3 * 256,
                                         "surface-area-cheapest splits weighed again with the sample"));
          p.push_back(ParamSpec::choice(
-             "occlusion", "near", {"near", "sample"},
-             "order in which occlusion rays enter a node's children: near (front to back, as every BVH; the model "
-             "describes it) or sample (the child likelier to end the ray per primitive first, an order bit per "
-             "node; outside the model's exact replay)"));
+             "occlusion", "auto", {"auto", "near", "leaves", "sample"},
+             "order in which occlusion rays enter a node's children: near (front to back, as every BVH), leaves "
+             "(leaf children first, then front to back), auto (of near and leaves, the one the model predicts "
+             "cheaper on the sample), or sample (the child likelier to end the ray per primitive first, an order "
+             "bit per node; outside the model's exact replay)"));
          p.push_back(ParamSpec::real("trust", "32", 0, 1e30,
                                      "sample segments at a node at which sample and surface area weigh alike "
                                      "(large: the surface area heuristic)"));
@@ -245,15 +247,37 @@ const Registration reg{
          o.trust = p.real("trust");
          const DesignInput in = draw_design_input(s, p);
          Designed d = build_design(s, in, o);
-         // bvh-sah's tree (front-to-back order) where the model predicts it cheaper on the sample
-         // than the designed splits (replayed front to back): design/cheaper.hpp.
+         // bvh-sah's tree where the model predicts it cheaper on the sample than the designed
+         // splits (as design/cheaper.hpp does for the other families).
          SahOptions usual;
          usual.max_depth = o.max_depth;
          usual.bins = o.bins;
          auto designed = std::make_unique<Bvh>(s, "bvh-design", d.data, true);
          auto by_sah = std::make_unique<Bvh>(s, "bvh-design", build_sah(s, usual), true);
-         if (p.is("occlusion", "near"))
-             return designing::cheaper_on_sample(std::move(designed), std::move(by_sah), s, in);
+         if (!p.is("occlusion", "sample")) {
+             // Each tree in the order asked for, or in the order the model predicts cheaper on
+             // the sample (only its occlusion rays can tell the two apart).
+             const bool any_query = std::find(in.sample.queries.begin(), in.sample.queries.end(), Query::Any) !=
+                                    in.sample.queries.end();
+             const bool try_near = !p.is("occlusion", "leaves");
+             const bool try_leaves = p.is("occlusion", "leaves") || (p.is("occlusion", "auto") && any_query);
+             struct Choice {
+                 Bvh* h;
+                 bool leaves;
+                 double cost;
+             } best{nullptr, false, 0};
+             for (Bvh* h : {designed.get(), by_sah.get()}) {  // a tie keeps the designed splits
+                 for (bool leaves : {false, true}) {
+                     if (!(leaves ? try_leaves : try_near)) continue;
+                     h->set_any_leaves_first(leaves);
+                     const double c = sample_cost(*h, s, in.sample, in.costs);
+                     if (!best.h || c < best.cost) best = {h, leaves, c};
+                 }
+             }
+             best.h->set_any_leaves_first(best.leaves);
+             if (best.h == designed.get()) return designed;
+             return by_sah;
+         }
          if (sample_cost(*by_sah, s, in.sample, in.costs) <
              sample_cost(*designed, s, in.sample, in.costs))
              return by_sah;

@@ -26,6 +26,7 @@ StructureStats Bvh::compute_structure() const {
 bool Bvh::emit_model(ModelSink& sink) const {
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     f.cull = ordered_;
+    f.any_leaves_first = ordered_ && any_leaves_first_;
     if (!sink.begin(f) || d_.nodes.empty()) return true;
     auto emit = [&](auto&& self, std::uint32_t i) -> void {
         const Node& n = d_.nodes[i];
@@ -49,10 +50,16 @@ bool Bvh::emit_model(ModelSink& sink) const {
 
 namespace {
 
-bool ordered(const Params& p) { return p.is("order", "near"); }
+// The traversal order the `order` parameter asks for, set on the built hierarchy.
+std::unique_ptr<Bvh> ordered(const Scene& s, const char* name, BvhData data, const Params& p) {
+    auto h = std::make_unique<Bvh>(s, name, std::move(data), !p.is("order", "none"));
+    h->set_any_leaves_first(p.is("order", "leaves"));
+    return h;
+}
 
-const ParamSpec kOrder = ParamSpec::choice("order", "near", {"near", "none"},
+const ParamSpec kOrder = ParamSpec::choice("order", "near", {"near", "leaves", "none"},
                                            "near: near child first, far child skipped beyond the current hit; "
+                                           "leaves: as near, but occlusion queries enter leaf children first; "
                                            "none: every child met is visited (the paper's BVH case)");
 constexpr long long kMaxLeaf = 1 << 20;
 
@@ -65,7 +72,7 @@ const Registration median_reg{
          MedianOptions o;
          o.max_prims = static_cast<int>(p.integer("max_prims"));
          o.max_depth = static_cast<int>(p.integer("max_depth"));
-         return std::make_unique<Bvh>(s, "bvh-median", build_median(s, o), ordered(p));
+         return ordered(s, "bvh-median", build_median(s, o), p);
      }},
     {{{}, kTestHits | kTestSampled | kTestSpdModel},
      {{"order=none"}, kTestHits}}};
@@ -86,12 +93,13 @@ const Registration gs_reg{
          o.max_depth = static_cast<int>(p.integer("max_depth"));
          o.max_children = static_cast<int>(p.integer("max_children"));
          o.seed = static_cast<std::uint64_t>(p.integer("seed"));
-         return std::make_unique<Bvh>(s, "bvh-gs", build_gs(s, o), ordered(p));
+         return ordered(s, "bvh-gs", build_gs(s, o), p);
      },
      kLargeScene},  // insertion from the root, one object at a time: 10 s for a million
     {{{}, kTestHits | kTestSampled | kTestSpdModel},
      {{"seed=0"}, kTestHits},
-     {{"seed=7", "max_prims=3"}, kTestHits}}};
+     {{"seed=7", "max_prims=3"}, kTestHits},
+     {{"seed=3", "max_children=6", "order=leaves"}, kTestHits | kTestSampled}}};
 
 const Registration sah_reg{
     {"bvh-sah",
@@ -111,10 +119,11 @@ const Registration sah_reg{
          o.sweep = p.flag("sweep");
          o.c_trav = static_cast<float>(p.real("c_trav"));
          o.c_isect = static_cast<float>(p.real("c_isect"));
-         return std::make_unique<Bvh>(s, "bvh-sah", build_sah(s, o), ordered(p));
+         return ordered(s, "bvh-sah", build_sah(s, o), p);
      }},
     {{{}, kTestHits | kTestSampled | kTestSpdModel},
      {{"sweep=1", "order=none"}, kTestHits},
+     {{"order=leaves"}, kTestHits | kTestSampled},
      {{"order=none"}, kTestSampled}}};
 
 }  // namespace

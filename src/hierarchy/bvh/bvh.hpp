@@ -67,6 +67,11 @@ public:
     bool emit_model(ModelSink& sink) const override;
     /// The built nodes and references (a traversal of another order reads them: bvh-design).
     const BvhData& data() const { return d_; }
+    /// Ordered any-hit (occlusion) queries enter a node's leaf children before its interior ones
+    /// (only a leaf can end the query), nearest first within each, a tie to the later child: a
+    /// large occluder held high in the tree (a floor, a wall) is tested before everything nearer.
+    void set_any_leaves_first(bool on) { any_leaves_first_ = on; }
+    bool any_leaves_first() const { return any_leaves_first_; }
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
@@ -126,7 +131,12 @@ private:
                     const float tb = box_entry(nodes[n.index + 1].box, ri, ray.tmin, limit);
                     Entry a{n.index, ta, e.depth + 1}, b{n.index + 1, tb, e.depth + 1};
                     if constexpr (kOrdered) {
-                        if (tb < ta) std::swap(a, b);
+                        if (Q == Query::Any && any_leaves_first_) {
+                            const bool la = nodes[a.node].leaf, lb = nodes[b.node].leaf;
+                            if (la != lb ? lb : !(ta < tb)) std::swap(a, b);
+                        } else if (tb < ta) {
+                            std::swap(a, b);
+                        }
                     }
                     if (a.t != kInf) {
                         if (b.t != kInf) {
@@ -150,11 +160,20 @@ private:
                     if (t != kInf) hits[nh++] = {n.index + k, t, e.depth + 1};
                 }
                 if constexpr (kOrdered) {
-                    // Nearest last, so it is popped first. Fan-out is small: insertion sort.
+                    // Nearest last, so it is popped first (any_leaves_first: leaves last, each
+                    // group nearest last). Fan-out is small: insertion sort.
+                    const bool leaves_first = Q == Query::Any && any_leaves_first_;
+                    auto taken_before = [&](const Entry& x, const Entry& y) {
+                        if (leaves_first) {
+                            const bool lx = nodes[x.node].leaf, ly = nodes[y.node].leaf;
+                            if (lx != ly) return lx;
+                        }
+                        return x.t < y.t;
+                    };
                     for (int i = 1; i < nh; ++i) {
                         Entry x = hits[i];
                         int j = i - 1;
-                        for (; j >= 0 && hits[j].t < x.t; --j) hits[j + 1] = hits[j];
+                        for (; j >= 0 && taken_before(hits[j], x); --j) hits[j + 1] = hits[j];
                         hits[j + 1] = x;
                     }
                     for (int i = 0; i < nh; ++i) stack[sp++] = hits[i];
@@ -178,6 +197,7 @@ private:
     std::string name_;
     BvhData d_;
     bool ordered_;
+    bool any_leaves_first_ = false;
     std::vector<LeafPrim> prims_;  ///< BvhData::refs as their tests need them, in leaf order
 };
 
