@@ -2,8 +2,9 @@
 // Embree on the same scenes and the same rays, and the geometric estimator against tracing the
 // `spd` rays. Run: build/bench/rtcost_bench [--benchmark_filter=...]; docs/benchmarks.md says how.
 // Scenes come from ../shared/scenes/spd when present (RTCOST_SHARED overrides), else built-ins;
-// meshes from RTCOST_BENCH_MESHES (default build/meshes), written by scripts/tessellate.py;
-// RTCOST_BENCH_VIEW sets one scene's camera and light (an earlier run's view, below).
+// meshes from RTCOST_BENCH_MESHES (default build/meshes), written by scripts/tessellate.py and
+// viewed with their SPD scene's camera and lights; RTCOST_BENCH_VIEW sets one scene's camera and
+// light instead (an earlier run's view, below).
 #include <benchmark/benchmark.h>
 
 #include <chrono>
@@ -51,6 +52,18 @@ Workload& workload(const std::string& name) {
     if (!w) {
         w = std::make_unique<Workload>();
         w->scene = load_scene(scene_path(name));
+        // A mesh tessellated from an SPD scene (scripts/tessellate.py keeps its coordinates) is
+        // viewed with that scene's camera and lights, not the default mesh camera: the same eye,
+        // and shadow rays that the scene's own occluders block.
+        if (name.ends_with("-mesh.obj")) {
+            const std::string nff = shared_dir() + "/scenes/spd/" + name.substr(0, name.size() - 9) + ".nff";
+            if (std::filesystem::exists(nff)) {
+                const Scene source = load_scene(nff);
+                w->scene.camera = source.camera;
+                w->scene.has_camera = source.has_camera;
+                w->scene.lights = source.lights;
+            }
+        }
         // RTCOST_BENCH_VIEW="SCENE|fx,fy,fz,ax,ay,az,ux,uy,uz,fov|x,y,z": another camera and light for
         // one scene (as rtcost's --camera and --light), e.g. the mesh camera of an earlier run.
         if (const char* env = std::getenv("RTCOST_BENCH_VIEW")) {
