@@ -63,7 +63,7 @@ public:
     static constexpr int kLocateStack = kMaxDepth + 8;  // one extra per axis the ray lies in
     static constexpr int kRecursiveStack = kMaxDepth + 2;  // one waiting child per level
 
-    Bsp(const Scene& s, const Options& o) : CellTree(s, o) {}
+    Bsp(const Scene& s, const Options& o) : CellTree(s, o) { build_tree(); }
 
     /// The two halves at the mid-plane of axis depth % 3; none where the growth guard, at the
     /// top of a block of three levels, keeps the cell a leaf.

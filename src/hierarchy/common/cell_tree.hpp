@@ -89,11 +89,16 @@ public:
     }
 
 protected:
-    /// Builds the whole tree (the empty scene: one empty leaf in a point box).
-    CellTree(const Scene& s, const CellOptions& o) : HierarchyImpl<Derived>(s), o_(o), root_(s.bounds()) {
+    CellTree(const Scene& s, const CellOptions& o) : HierarchyImpl<Derived>(s), o_(o), root_(s.bounds()) {}
+
+    /// Builds the whole tree (the empty scene: one empty leaf in a point box). Called by the
+    /// family's constructor, not by this one: the build asks the family how to split, and a
+    /// base's constructor runs before the family object exists.
+    void build_tree() {
+        const Scene& s = *this->scene_;
         const bool empty = s.empty() || root_.empty();
         if (empty) root_ = Box3{{0, 0, 0}, {0, 0, 0}};
-        const Assigner as(s, o.assign);
+        const Assigner as(s, o_.assign);
         std::vector<std::uint32_t> refs = empty ? std::vector<std::uint32_t>{} : as.all();
         nodes_.emplace_back();
         build(0, root_, 0, refs, as);

@@ -63,7 +63,7 @@ public:
     static constexpr int kLocateStack = 8 * (kMaxDepth + 2);
     static constexpr int kRecursiveStack = 8 * (kMaxDepth + 2);  // at most seven waiting children per level
 
-    Octree(const Scene& s, const Options& o) : CellTree(s, o) {}
+    Octree(const Scene& s, const Options& o) : CellTree(s, o) { build_tree(); }
 
     /// The eight octants at the centre; none where the growth guard keeps the cell a leaf.
     int split(const Box3& cell, int depth, const std::vector<std::uint32_t>& refs, const subdiv::Assigner& as,
