@@ -8,6 +8,7 @@
 #include <benchmark/benchmark.h>
 
 #include <chrono>
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -73,7 +74,12 @@ Workload& workload(const std::string& name) {
                 ViewSpec view;
                 view.camera = v.substr(a + 1, b - a - 1);
                 view.lights.push_back(v.substr(b + 1));
-                apply_view(w->scene, view);
+                try {
+                    apply_view(w->scene, view);
+                } catch (const std::exception& e) {
+                    std::fprintf(stderr, "rtcost_bench: error: RTCOST_BENCH_VIEW: %s\n", e.what());
+                    std::exit(2);
+                }
             }
         }
     }

@@ -1,6 +1,7 @@
 #pragma once
 // What the model's files share (not public API): Crofton geometry, the recursion over a
 // materialised model tree and its per-node probabilities, 5D beam weights.
+#include <algorithm>
 #include <array>
 #include <span>
 #include <string>
@@ -85,6 +86,21 @@ struct Walk {
 /// Whether a hit found ends (part of) the search: an any-hit query stops at its first hit; a
 /// closest-hit one skips what lies beyond, unless the traversal visits everything (ModelFlags::cull).
 inline bool terminates(const ModelFlags& f, Query q) { return q == Query::Any || (q == Query::Closest && f.cull); }
+
+/// Sorts the children a segment meets, (entry t, child index) with the child at `t.nodes[base +
+/// index]`, into the order an ordered traversal enters them: nearest first, a tie (a ray starting
+/// inside several) to the later child; with `leaves_first` (an any-hit query of a tree that
+/// declares ModelFlags::any_leaves_first) leaf children before interior ones.
+inline void sort_children_met(std::span<std::pair<float, std::uint32_t>> met, const ModelTree& t, std::uint32_t base,
+                              bool leaves_first) {
+    std::sort(met.begin(), met.end(), [&](const auto& a, const auto& b) {
+        if (leaves_first) {
+            const bool la = t.nodes[base + a.second].leaf, lb = t.nodes[base + b.second].leaf;
+            if (la != lb) return la;
+        }
+        return a.first < b.first || (a.first == b.first && a.second > b.second);
+    });
+}
 
 /// Adds the operations of one visit of `m` to `c`, scaled by `p` (visits) and `pg` (visits that
 /// pass the node's bounding volume): the node's own, or the tree's declared `paper` charges

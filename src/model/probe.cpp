@@ -230,16 +230,8 @@ private:
                 const Segment sc = child(m.first + k, s);
                 if (!sc.empty()) met[nm++] = {sc.t0, m.first + k};
             }
-            // Ties (a ray starting inside several) go to the later child, as the traversal's sort does.
-            if (any_ && t_.any_leaves_first)
-                std::sort(met.begin(), met.begin() + nm, [&](auto& a, auto& b) {
-                    const bool la = t_.nodes[a.second].leaf, lb = t_.nodes[b.second].leaf;
-                    if (la != lb) return la;
-                    return a.first < b.first || (a.first == b.first && a.second > b.second);
-                });
-            else if (t_.cull)
-                std::sort(met.begin(), met.begin() + nm,
-                          [](auto& a, auto& b) { return a.first < b.first || (a.first == b.first && a.second > b.second); });
+            const bool leaves_first = any_ && t_.any_leaves_first;
+            if (t_.cull || leaves_first) sort_children_met({met.data(), nm}, t_, 0, leaves_first);
             for (std::size_t k = 0; k < nm && !done(); ++k) {
                 const Segment sc = child(met[k].second, s);
                 if (!beyond(sc)) visit(met[k].second, sc);

@@ -68,19 +68,11 @@ struct RayCostModel::Impl {
             segs[k] = sc;
             met[nm++] = {sc.t0, k};
         }
-        if (any_query && tree.any_leaves_first) {
-            std::sort(met.begin(), met.begin() + nm, [&](auto& a, auto& b) {
-                const bool la = tree.nodes[m.first + a.second].leaf, lb = tree.nodes[m.first + b.second].leaf;
-                if (la != lb) return la;
-                return a.first < b.first || (a.first == b.first && a.second > b.second);
-            });
-        } else if (tree.cull) {
-            if (m.count == 2)
-                std::stable_sort(met.begin(), met.begin() + nm, [](auto& a, auto& b) { return a.first < b.first; });
-            else
-                std::sort(met.begin(), met.begin() + nm,
-                          [](auto& a, auto& b) { return a.first < b.first || (a.first == b.first && a.second > b.second); });
-        }
+        const bool leaves_first = any_query && tree.any_leaves_first;
+        if (tree.cull && m.count == 2 && !leaves_first)  // a binary node's tie: the first child
+            std::stable_sort(met.begin(), met.begin() + nm, [](auto& a, auto& b) { return a.first < b.first; });
+        else if (tree.cull || leaves_first)
+            sort_children_met({met.data(), nm}, tree, m.first, leaves_first);
         double reach = pg;
         for (std::size_t i = 0; i < nm; ++i) {
             const std::uint32_t child = m.first + met[i].second;
