@@ -105,7 +105,9 @@ std::uint32_t collapse(const bvh::BvhData& bd, std::vector<Node<W>>& out) {
 template <int K>
 void append_leaf(std::vector<BvhWide::Data::Block>& arena, const Scene& s, std::span<const std::uint32_t> ids,
                  std::uint32_t& child, std::uint32_t& count) {
-    std::vector<std::uint32_t> tris, others;
+    // Reused from leaf to leaf: a build appends some 100,000 leaves.
+    thread_local std::vector<std::uint32_t> tris, others;
+    tris.clear(), others.clear();
     auto triangle = [&](std::uint32_t id, Triangle& t) {
         const PrimRef& r = s.prims[id];
         if (r.kind == PrimKind::Triangle) {
