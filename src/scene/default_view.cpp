@@ -85,16 +85,24 @@ struct ViewRaster {
 
 // Trims the window's emptiest edge rows and columns while fewer than 60% of its cells see the
 // object (a margin over "most" for what the raster misses), keeping at least a third of its width
-// and of its height. Returns [i0, i1) x [j0, j1).
-std::array<int, 4> trim_empty_edges(const ViewRaster& v) {
+// and of its height, and the image's aspect (`aspect`: width over height of the whole raster, in
+// pixels) within 1:4 .. 4:1, which the camera would otherwise restore with empty rows. Returns
+// [i0, i1) x [j0, j1).
+std::array<int, 4> trim_empty_edges(const ViewRaster& v, double aspect) {
     int i0 = 0, i1 = v.n, j0 = 0, j1 = v.n;
     const int keep = v.n / 3;
+    auto shape_ok = [&](int w, int h) {
+        const double a = aspect * w / h;
+        return w >= keep && h >= keep && a >= 0.25 && a <= 4;
+    };
     while (5 * v.covered(i0, i1, j0, j1) < 3 * (i1 - i0) * (j1 - j0)) {
         // Each edge's share of covered cells; the emptiest one that may still go is removed.
-        const double left = i1 - i0 > keep ? double(v.covered(i0, i0 + 1, j0, j1)) / (j1 - j0) : 2;
-        const double right = i1 - i0 > keep ? double(v.covered(i1 - 1, i1, j0, j1)) / (j1 - j0) : 2;
-        const double bottom = j1 - j0 > keep ? double(v.covered(i0, i1, j0, j0 + 1)) / (i1 - i0) : 2;
-        const double top = j1 - j0 > keep ? double(v.covered(i0, i1, j1 - 1, j1)) / (i1 - i0) : 2;
+        const int w = i1 - i0, h = j1 - j0;
+        const bool cols = shape_ok(w - 1, h), rows = shape_ok(w, h - 1);
+        const double left = cols ? double(v.covered(i0, i0 + 1, j0, j1)) / h : 2;
+        const double right = cols ? double(v.covered(i1 - 1, i1, j0, j1)) / h : 2;
+        const double bottom = rows ? double(v.covered(i0, i1, j0, j0 + 1)) / w : 2;
+        const double top = rows ? double(v.covered(i0, i1, j1 - 1, j1)) / w : 2;
         const double least = std::min({left, right, bottom, top});
         if (least > 1) break;
         if (least == left) ++i0;
@@ -109,7 +117,7 @@ std::array<int, 4> trim_empty_edges(const ViewRaster& v) {
 // image empty. When fewer than half the camera's pixels would see the object (on a z-buffer of the
 // camera's own perspective image, every primitive), the camera turns to the part of the image that
 // trim_empty_edges keeps and narrows its angle to it, from where it stands: a crop of the image.
-void crop_to_object(const Scene& scene, Camera& cam) {
+bool crop_to_object(const Scene& scene, Camera& cam) {
     const Vec3 fwd = normalize(cam.at - cam.from), right = normalize(cross(fwd, cam.up)), up = cross(right, fwd);
     const double tan_v = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0), tan_h = tan_v * cam.width / cam.height;
     // Image coordinates in [-1, 1] and -1/z, which is affine across a projected triangle.
@@ -148,10 +156,11 @@ void crop_to_object(const Scene& scene, Camera& cam) {
             if (!behind) v.rect(lr, hr, lu, hu, z, pid);
         }
     }
-    const auto [i0, i1, j0, j1] = trim_empty_edges(v);
-    if (i1 - i0 == v.n && j1 - j0 == v.n) return;
+    const auto [i0, i1, j0, j1] = trim_empty_edges(v, double(cam.width) / cam.height);
+    if (i1 - i0 == v.n && j1 - j0 == v.n) return false;
     // The kept window's corners, as directions from the eye; the new view is aimed at its centre
-    // and spans all four corners.
+    // and spans all four corners. (Moving the eye sideways instead would keep the window's shape
+    // but not its content: parallax moves a deep object's near parts out of it.)
     auto dir = [&](int i, int j) {
         return fwd + right * static_cast<float>((-1 + 2.0 * i / v.n) * tan_h) + up * static_cast<float>((-1 + 2.0 * j / v.n) * tan_v);
     };
@@ -163,13 +172,14 @@ void crop_to_object(const Scene& scene, Camera& cam) {
         th = std::max<double>(th, std::fabs(dot(w, r2)) / dot(w, aim));
         tv = std::max<double>(tv, std::fabs(dot(w, u2)) / dot(w, aim));
     }
-    if (!(th > 0 && tv > 0)) return;
+    if (!(th > 0 && tv > 0)) return false;
     const double aspect = std::clamp(th / tv, 0.25, 4.0);
     tv = std::max(tv, th / aspect);
     cam.width = aspect >= 1 ? 512 : std::max(128, static_cast<int>(std::lround(512 * aspect)));
     cam.height = aspect >= 1 ? std::max(128, static_cast<int>(std::lround(512 / aspect))) : 512;
     cam.angle = static_cast<float>(2 * std::atan(tv) * 180 / std::numbers::pi);
     cam.at = cam.from + aim * length(cam.at - cam.from);
+    return true;
 }
 
 }  // namespace
@@ -316,7 +326,8 @@ Camera Scene::default_camera(Vec3 c, float radius) const {
     cam.from = at + best_dir * static_cast<float>(dist);
     cam.up = f.up;
     cam.hither = radius * 1e-3f;
-    crop_to_object(*this, cam);
+    // A turned view frames the window's corners, a little more than the window: crop again.
+    for (int pass = 0; pass < 3 && crop_to_object(*this, cam); ++pass) {}
     return cam;
 }
 
