@@ -79,39 +79,24 @@ public:
     }
 
     BvhData build() {
-        BvhData d;
-        d.nodes.reserve(2 * refs_.size() + 1);
-        d.nodes.emplace_back();
-        recurse(d, 0, 0, static_cast<std::uint32_t>(refs_.size()), 0);
-        d.nodes.shrink_to_fit();
+        BvhData d = build_nodes(
+            static_cast<std::uint32_t>(refs_.size()),
+            [&](std::uint32_t begin, std::uint32_t end) {
+                // The centroids' box too, kept for the split of this same node, which comes next.
+                Box4 box, cb;
+                for (std::uint32_t i = begin; i < end; ++i) box.extend(refs_[i].lo, refs_[i].hi), cb.extend(refs_[i].centroid());
+                centroid_box_ = cb.box3();
+                return box.box3();
+            },
+            [&](std::uint32_t begin, std::uint32_t end, const Box3& box, int depth) {
+                return split(begin, end, box, centroid_box_, depth);
+            });
         d.refs.resize(refs_.size());
         for (std::size_t i = 0; i < refs_.size(); ++i) d.refs[i] = refs_[i].id();
         return d;
     }
 
 private:
-    void recurse(BvhData& d, std::uint32_t node, std::uint32_t begin, std::uint32_t end, int depth) {
-        Box4 box4, cb4;
-        for (std::uint32_t i = begin; i < end; ++i) box4.extend(refs_[i].lo, refs_[i].hi), cb4.extend(refs_[i].centroid());
-        const Box3 box = box4.box3();
-        d.nodes[node].box = box;
-        const std::uint32_t mid = end - begin > 1 ? split(begin, end, box, cb4.box3(), depth) : begin;
-        if (mid <= begin || mid >= end) {
-            d.nodes[node].index = begin;
-            d.nodes[node].count = end - begin;
-            d.nodes[node].leaf = 1;
-            return;
-        }
-        const auto left = static_cast<std::uint32_t>(d.nodes.size());
-        d.nodes.emplace_back();
-        d.nodes.emplace_back();
-        d.nodes[node].index = left;
-        d.nodes[node].count = 2;
-        d.nodes[node].leaf = 0;
-        recurse(d, left, begin, mid, depth + 1);
-        recurse(d, left + 1, mid, end, depth + 1);
-    }
-
     // Every bin boundary on each axis (Wald 2007), the three axes binned in one pass.
     Split best(std::uint32_t begin, std::uint32_t end, const Box3& cb) {
         const int nbins = o_.bins;
@@ -188,6 +173,7 @@ private:
 
     const SahOptions& o_;
     std::vector<BoxRef> refs_;
+    Box3 centroid_box_;
     std::vector<Box4> bins_;
     std::vector<std::uint32_t> counts_;
     std::vector<float> right_area_;
