@@ -100,5 +100,23 @@ TEST(DefaultView, MostCameraRaysHitAThinObject) {
     EXPECT_LT(std::fabs(dot(v, right)) / dot(v, fwd), tan_v * s.camera.width / s.camera.height);
 }
 
+// The same view at any scale: a tetrahedron 1e-12 across is framed as one 1 across (the crop's
+// near limit was once absolute, which put every primitive of a tiny scene behind the eye).
+TEST(DefaultView, ATinySceneIsFramedLikeALargeOne) {
+    for (float size : {1.0f, 1e-12f}) {
+        Scene s;
+        s.name = "tetrahedron";
+        const Vec3 p[4] = {{0, 0, 0}, {size, 0, 0}, {0, size, 0}, {0, 0, size}};
+        s.add(Triangle{p[0], p[1], p[2]}, 0);
+        s.add(Triangle{p[0], p[1], p[3]}, 0);
+        s.add(Triangle{p[0], p[2], p[3]}, 0);
+        s.add(Triangle{p[1], p[2], p[3]}, 0);
+        s.finalize();
+        const Seen seen = look(s, 0);
+        EXPECT_GT(seen.hits, seen.rays / 2) << size << ": " << seen.hits << " of " << seen.rays;
+        EXPECT_GT(s.camera.angle, 10) << size;
+    }
+}
+
 }  // namespace
 }  // namespace rtcost::test

@@ -121,7 +121,7 @@ bool crop_to_object(const Scene& scene, Camera& cam) {
     const Vec3 fwd = normalize(cam.at - cam.from), right = normalize(cross(fwd, cam.up)), up = cross(right, fwd);
     const double tan_v = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0), tan_h = tan_v * cam.width / cam.height;
     // Image coordinates in [-1, 1] and -1/z, which is affine across a projected triangle.
-    const double near = 1e-9 * std::max(1.0, double(length(cam.at - cam.from)));
+    const double near = 1e-9 * double(length(cam.at - cam.from));  // relative: a scene may be tiny
     bool behind = false;
     auto at = [&](Vec3 p) {
         const Vec3 q = p - cam.from;
@@ -156,6 +156,7 @@ bool crop_to_object(const Scene& scene, Camera& cam) {
             if (!behind) v.rect(lr, hr, lu, hu, z, pid);
         }
     }
+    if (v.covered(0, v.n, 0, v.n) == 0) return false;  // nothing seen (every primitive behind the eye): keep the frame
     const auto [i0, i1, j0, j1] = trim_empty_edges(v, double(cam.width) / cam.height);
     if (i1 - i0 == v.n && j1 - j0 == v.n) return false;
     // The kept window's corners, as directions from the eye; the new view is aimed at its centre

@@ -51,7 +51,6 @@ Split best_sweep(std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint
     return best;
 }
 
-
 // Bin indices of a centroid on the three axes: bin_of lane by lane.
 inline std::array<int, 3> bins_of(f4 c, f4 lo, f4 scale, int nbins) {
 #if defined(__SSE2__)
