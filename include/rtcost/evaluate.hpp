@@ -41,6 +41,8 @@ std::vector<std::string> left_out_of_all(std::string_view list, std::size_t prim
 /// asked for is measured on a subset of the rays: about kBruteTests primitive tests in all.
 inline constexpr std::size_t kBruteLimit = kBruteInAll;
 inline constexpr std::size_t kBruteTests = 200'000'000;
+/// Rays per kind in the geometric estimator's visibility sample (draw_visibility_sample).
+inline constexpr std::size_t kVisibilityRays = 2048;
 
 struct EvalRow;
 
@@ -109,6 +111,9 @@ struct EvalResult {
     std::size_t test_rays = 0, training_rays = 0;
     std::size_t sample_rays = 0;       ///< the segments estimator's sample (disjoint from the test rays)
     double sample_seconds = 0;         ///< drawing it (once for every hierarchy)
+    /// The geometric estimator's visibility sample (draw_visibility_sample; under termination).
+    std::size_t visibility_rays = 0;
+    double visibility_seconds = 0;
     /// How the rays were split: "none", "fresh draw" (lines, random), "pseudo-random half", or
 /// "sample" (the segments estimator's sample left out of the test rays).
     std::string split;

@@ -145,8 +145,9 @@ Prediction predict_segments(const ModelTree& tree, const Scene& scene, const Ray
 class SegmentsPredictor {
 public:
     /// Materialises the part of `h`'s model tree that `sample` can reach. `h`, `scene` and
-    /// `sample` must outlive the predictor.
-    SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample);
+    /// `sample` must outlive the predictor. `nodes`: the hierarchy's nodes when the caller has
+    /// its structure() already (0: counted here, a walk over the whole hierarchy).
+    SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample, std::size_t nodes = 0);
     /// predict_segments over the sample's rays `rays`.
     Prediction predict(std::span<const std::uint32_t> rays, const ModelOptions& opt, const UnitCosts& costs = {});
     /// Seconds spent materialising trees so far (the reached one, and the whole one if needed).

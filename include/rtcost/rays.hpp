@@ -33,6 +33,9 @@ std::vector<Ray> random_rays(const Box3& box, std::size_t n, std::uint64_t seed)
 /// its bounding sphere), each aimed at a uniformly random point of a primitive chosen uniformly
 /// at random; unit directions, (0, +inf).
 std::vector<Ray> aimed_rays(const Scene& scene, std::size_t n, std::uint64_t seed);
+/// The same with each target's primitive chosen, with probability `by_area`, in proportion to
+/// its area instead of uniformly.
+std::vector<Ray> aimed_rays(const Scene& scene, std::size_t n, std::uint64_t seed, double by_area);
 
 /// What a ray in a ray set is for. Generated distributions are all `Eye` or `Line`; the SPD
 /// Whitted tree mixes eye, reflection, refraction and shadow rays.

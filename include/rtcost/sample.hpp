@@ -56,6 +56,22 @@ RaySample draw_sample(const Scene& scene, const RaySpec& spec, std::size_t count
 RaySample draw_sample_from(const Scene& scene, const RaySet& all, std::size_t count, std::uint64_t seed,
                            const Hierarchy& reference, Query query = Query::Closest, Query occlusion = Query::Any);
 
+/// Finds how each of `s`'s rays ends (t_end and crossings, replacing any) with `reference`, an
+/// exact hierarchy over the scene, tracing with the rays' own tmin and tmax.
+void find_ends(RaySample& s, const Hierarchy& reference);
+
+/// A sample of the scene alone, for predictions without the user's rays (the geometric
+/// estimator under termination): `per_kind` rays standing for each of `kinds`, made from the
+/// geometry and the lights only, never from the camera. Eye, line and file rays are aimed rays
+/// from outside, their targets chosen half by primitive and half by area (aimed_rays). The
+/// others start where such rays first meet a surface, on the side they came from: shadow rays towards one of the scene's lights (cosine-
+/// weighted without lights), diffuse and ambient-occlusion rays cosine-weighted (the latter
+/// ao_length() long), reflection rays mirrored, refraction rays straight on. Ends are found
+/// with `reference`. Deterministic for a seed; `population` is 0 (no distribution behind it).
+RaySample draw_visibility_sample(const Scene& scene, std::span<const RayKind> kinds, std::size_t per_kind,
+                                 std::uint64_t seed, const Hierarchy& reference, Query query = Query::Closest,
+                                 Query occlusion = Query::Any);
+
 /// The rays of `all` that are not in the sample drawn from it with the same count and seed (the
 /// test rays disjoint from a sample), in their order.
 RaySet rays_outside_sample(const RaySet& all, std::size_t count, std::uint64_t seed);

@@ -144,6 +144,10 @@ void split_half(RaySet& all, RaySet& train, std::size_t sample) {
     all = std::move(keep);
 }
 
+constexpr const char* kVisibilityNote =
+    "P from the scene's own visibility: where rays aimed at the primitives from outside, and rays spawned where "
+    "they first meet a surface, end (no ray of the distribution traced)";
+
 bool wants(const EvalOptions& opt, Estimator e) {
     return std::find(opt.estimators.begin(), opt.estimators.end(), e) != opt.estimators.end();
 }
@@ -182,6 +186,26 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                 throw InputError("--sample", 0,
                                  "the sample has no rays of kind " + std::string(ray_kind_name(static_cast<RayKind>(k))) +
                                      ": draw a larger one");
+    }
+    // The geometric estimator under termination learns where searches end from the scene's own
+    // visibility (draw_visibility_sample): no ray of the user's, no hierarchy's traversal.
+    std::optional<RaySample> visibility;
+    std::array<std::vector<std::uint32_t>, kRayKinds> visibility_kinds;
+    if (wants(opt, Estimator::Geometric)) {
+        std::vector<RayKind> kinds;
+        for (int k = 0; k < kRayKinds; ++k)
+            if (!test_kinds[k].empty() && query_of(k) != Query::All) kinds.push_back(static_cast<RayKind>(k));
+        if (!kinds.empty()) {
+            if (opt.on_step) opt.on_step("visibility sample");
+            const auto start = std::chrono::steady_clock::now();
+            auto reference = build_hierarchy(scene, "bvh-sah");
+            visibility = draw_visibility_sample(scene, kinds, kVisibilityRays, opt.sample_seed, *reference, opt.query,
+                                                opt.occlusion);
+            for (std::size_t i = 0; i < visibility->size(); ++i)
+                visibility_kinds[static_cast<int>(visibility->rays.kinds[i])].push_back(static_cast<std::uint32_t>(i));
+            res.visibility_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            res.visibility_rays = visibility->size();
+        }
     }
     res.split = std::move(split);
     res.query = opt.query;
@@ -255,6 +279,7 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         if (sampled && h->lazy())
             for (int k = 0; k < kRayKinds; ++k) trace_rays(*h, train_kinds[k]);
         if (sample && h->lazy()) trace_rays(*h, sample->rays.rays);
+        if (visibility && h->lazy()) trace_rays(*h, visibility->rays.rays);
         row.structure = h->structure();
         row.lazy = h->lazy();
         row.modelled = h->modelled();
@@ -268,7 +293,10 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
             const double tree_seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - tree_start).count();
             std::optional<SegmentsPredictor> segments;
-            if (sample && wants(opt, Estimator::Segments)) segments.emplace(*h, scene, *sample);
+            const std::size_t nodes = row.structure.interior + row.structure.leaves;
+            if (sample && wants(opt, Estimator::Segments)) segments.emplace(*h, scene, *sample, nodes);
+            std::optional<SegmentsPredictor> seen;  // over the visibility sample
+            if (visibility) seen.emplace(*h, scene, *visibility, nodes);
             // A fallback on the whole tree is timed within the prediction that needed it.
             const double reached_seconds = segments ? segments->tree_seconds() : 0.0;
             for (Estimator est : opt.estimators) {
@@ -287,6 +315,10 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                             parts.emplace_back(share, predict_sampled(tree, scene, train_kinds[k], o, costs));
                         } else if (est == Estimator::Segments) {
                             parts.emplace_back(share, segments->predict(sample_kinds[k], o, costs));
+                        } else if (o.query != Query::All) {
+                            parts.emplace_back(share, seen->predict(visibility_kinds[k], o, costs));
+                            parts.back().second.estimator = "geometric";
+                            parts.back().second.note = kVisibilityNote;
                         } else {
                             auto it = geometric.find(o.query);
                             if (it == geometric.end())
@@ -299,6 +331,7 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                     row.predictions.push_back(mix(parts, costs));
                     if (est == Estimator::Sampled) row.predictions.back().seconds += tree_seconds;
                     if (est == Estimator::Segments) row.predictions.back().seconds += reached_seconds;
+                    if (est == Estimator::Geometric && seen) row.predictions.back().seconds += seen->tree_seconds();
                 }
             }
         }

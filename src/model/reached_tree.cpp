@@ -110,13 +110,17 @@ ModelTree reached_model_tree(const Hierarchy& h, const RaySample& sample) {
 
 }  // namespace
 
-SegmentsPredictor::SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample)
+SegmentsPredictor::SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample,
+                                     std::size_t nodes)
     : h_(h), scene_(scene), sample_(sample) {
     const auto start = std::chrono::steady_clock::now();
     // A tree of a few nodes per sample ray (a BVH) is reached nearly everywhere: finding where
     // the segments reach would repeat the replay's clipping for nothing, so it is taken whole.
-    const StructureStats st = h.structure();
-    whole_ = st.interior + st.leaves <= kWholeNodesPerRay * std::max<std::size_t>(sample.size(), 1);
+    if (nodes == 0) {
+        const StructureStats st = h.structure();
+        nodes = st.interior + st.leaves;
+    }
+    whole_ = nodes <= kWholeNodesPerRay * std::max<std::size_t>(sample.size(), 1);
     tree_ = whole_ ? h.model_tree() : reached_model_tree(h, sample);
     tree_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }

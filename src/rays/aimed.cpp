@@ -1,6 +1,7 @@
 // `aimed` rays: incoherent rays that nearly all hit. Each starts at a uniform point of a sphere
 // around the scene (twice its bounding sphere) and points at a uniformly random point of a
 // primitive chosen uniformly at random, so it meets that primitive or something in front of it.
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -51,15 +52,28 @@ Vec3 on_cone(const Cone& c, Rng& rng) {
 }  // namespace
 
 std::vector<Ray> aimed_rays(const Scene& scene, std::size_t n, std::uint64_t seed) {
+    return aimed_rays(scene, n, seed, 0.0);
+}
+
+std::vector<Ray> aimed_rays(const Scene& scene, std::size_t n, std::uint64_t seed, double by_area) {
     std::vector<Ray> rays;
     if (scene.empty()) return rays;
+    std::vector<double> cdf;
+    if (by_area > 0) {
+        cdf.resize(scene.size());
+        double sum = 0;
+        for (std::uint32_t id = 0; id < scene.size(); ++id) cdf[id] = sum += std::max(0.0, double(scene.prim_area(id)));
+        if (!(sum > 0)) cdf.clear();
+    }
     rays.reserve(n);
     Rng rng(seed);
     const Vec3 centre = scene.bounds().center();
     const float radius = std::max(length(scene.bounds().extent()), 1e-30f);  // twice the half-diagonal
     while (rays.size() < n) {
         const Vec3 o = centre + rng.direction() * radius;
-        const auto id = static_cast<std::uint32_t>(rng.uniform() * static_cast<double>(scene.size()));
+        auto id = static_cast<std::uint32_t>(rng.uniform() * static_cast<double>(scene.size()));
+        if (!cdf.empty() && rng.uniform() < by_area)
+            id = static_cast<std::uint32_t>(std::upper_bound(cdf.begin(), cdf.end(), rng.uniform() * cdf.back()) - cdf.begin());
         const PrimRef& p = scene.prims[std::min<std::size_t>(id, scene.size() - 1)];
         Vec3 target;
         switch (p.kind) {

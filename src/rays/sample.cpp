@@ -61,6 +61,23 @@ RaySet rays_outside_sample(const RaySet& all, std::size_t count, std::uint64_t s
     return out;
 }
 
+void find_ends(RaySample& s, const Hierarchy& reference) {
+    const std::size_t n = s.rays.rays.size();
+    std::vector<std::vector<Crossing>> per(n);
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { per[i] = crossings(reference, s.rays.rays[i]); });
+    s.first.clear();
+    s.t_end.clear();
+    s.crossings.clear();
+    s.first.reserve(n + 1);
+    s.t_end.reserve(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        s.first.push_back(static_cast<std::uint32_t>(s.crossings.size()));
+        s.t_end.push_back(per[i].empty() ? s.rays.rays[i].tmax : per[i].front().t);
+        s.crossings.insert(s.crossings.end(), per[i].begin(), per[i].end());
+    }
+    s.first.push_back(static_cast<std::uint32_t>(s.crossings.size()));
+}
+
 RaySample draw_sample(const Scene& scene, const RaySpec& spec, std::size_t count, std::uint64_t seed,
                       const Hierarchy& reference, Query query, Query occlusion) {
     return draw_sample_from(scene, make_rays(scene, spec), count, seed, reference, query, occlusion);
@@ -82,16 +99,7 @@ RaySample draw_sample_from(const Scene& scene, const RaySet& all, std::size_t co
         s.rays.kinds.push_back(all.kinds[i]);
         s.queries.push_back(is_occlusion(all.kinds[i]) ? occlusion : query);
     }
-    std::vector<std::vector<Crossing>> per(idx.size());
-    tbb::parallel_for(std::size_t(0), idx.size(), [&](std::size_t i) { per[i] = crossings(reference, s.rays.rays[i]); });
-    s.first.reserve(idx.size() + 1);
-    s.t_end.reserve(idx.size());
-    for (std::size_t i = 0; i < idx.size(); ++i) {
-        s.first.push_back(static_cast<std::uint32_t>(s.crossings.size()));
-        s.t_end.push_back(per[i].empty() ? s.rays.rays[i].tmax : per[i].front().t);
-        s.crossings.insert(s.crossings.end(), per[i].begin(), per[i].end());
-    }
-    s.first.push_back(static_cast<std::uint32_t>(s.crossings.size()));
+    find_ends(s, reference);
     return s;
 }
 

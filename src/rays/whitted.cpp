@@ -149,8 +149,11 @@ RayTree join(std::vector<Recorder>& rows, bool record) {
 
 using PixelRng = ItemRng;  // one stream per pixel
 
-// Cosine-weighted direction about unit `n` (Malley's method: uniform on the disc, projected up).
-Vec3 cosine_direction(Vec3 n, PixelRng& rng) {
+}  // namespace
+
+namespace detail {
+// Malley's method: uniform on the disc, projected up.
+Vec3 cosine_direction(Vec3 n, ItemRng& rng) {
     double u1 = rng.uniform(), u2 = rng.uniform();
     double r = std::sqrt(u1), phi = 2 * std::numbers::pi * u2;
     Vec3 a = std::fabs(n.x) < 0.9f ? Vec3{1, 0, 0} : Vec3{0, 1, 0};
@@ -160,8 +163,9 @@ Vec3 cosine_direction(Vec3 n, PixelRng& rng) {
              n * static_cast<float>(std::sqrt(std::max(0.0, 1 - u1)));
     return normalize(d);
 }
+}  // namespace detail
 
-}  // namespace
+using detail::cosine_direction;
 
 RayTree whitted_tree(const Hierarchy& h, const WhittedOptions& opt) {
     const Scene& scene = h.scene();

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "rtcost/whitted.hpp"
+#include "util/rng.hpp"
 
 namespace rtcost::detail {
 
@@ -51,6 +52,9 @@ private:
     float eps_;
     float light_scale_;
 };
+
+/// A cosine-weighted unit direction about unit `n`.
+Vec3 cosine_direction(Vec3 n, ItemRng& rng);
 
 /// Calls row(j) for every j in [0, rows) on `threads` threads (0: all cores), reporting rows done.
 void run_rows(int rows, int threads, const std::function<void(int)>& row,

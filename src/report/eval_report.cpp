@@ -95,6 +95,8 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
             {"training_rays", r.training_rays},
             {"sample_rays", r.sample_rays},
             {"sample_seconds", r.sample_seconds},
+            {"visibility_rays", r.visibility_rays},
+            {"visibility_seconds", r.visibility_seconds},
             {"split", r.split},
             {"unit_costs", r.calibrated ? "ns" : "operations"},
             {"left_out", r.left_out},
@@ -148,7 +150,10 @@ std::string eval_header(const EvalResult& r) {
                        "costs in {}{}{}\n{}",
                        r.scene, r.primitives, r.test_rays, r.distribution, split, kinds, estimator_name(est),
                        preset_name(r.presets.front()), r.calibrated ? "ns (calibrated)" : "operations",
-                       est == Estimator::Geometric
+                       est == Estimator::Geometric && r.visibility_rays > 0
+                           ? fmt::format("; P from a visibility sample of the scene alone ({} rays, {:.2f} s)",
+                                         r.visibility_rays, r.visibility_seconds)
+                       : est == Estimator::Geometric
                            ? "; P of a hit in a region of several primitives by the Poisson form 1 - exp(-sum p_i)"
                            : "",
                        rough(r) ? "; with early termination this estimator is a rough guide (docs/model-accuracy.md)"
