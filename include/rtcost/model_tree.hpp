@@ -127,6 +127,11 @@ public:
         (void)beam;
         node(m, prims);
     }
+    /// Asked by an emitter right after an interior node: true when the sink has no use for that
+    /// node's subtree, which the emitter then leaves out (nothing of it is emitted). An emitter
+    /// that never asks emits every node, and a sink takes either. A ray sample reaches a small
+    /// part of a large tree: reading the rest only to drop it cost more than the prediction.
+    virtual bool skip_children() { return false; }
 };
 
 /// Emits a materialised model tree into `sink`, depth first (what Hierarchy::emit_model does

@@ -20,26 +20,29 @@ class PrimOracle {
 public:
     explicit PrimOracle(const Scene& s) : s_(s) {}
     PrimOracle(const Scene& s, const RaySample& sample, std::span<const std::uint32_t> index)
-        : s_(s), sample_(&sample), index_(index), known_(s.size(), kInf) {
-        for (const Crossing& c : sample.crossings)
-            if (c.prim >= s.size())
-                throw InputError("sample", 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
-                                                  std::to_string(s.size()) + " primitives): a sample of another scene?");
+        : s_(s), sample_(&sample), index_(index) {
+        for (std::uint32_t i : index)
+            for (const Crossing& c : sample.crossings_of(i))
+                if (c.prim >= s.size())
+                    throw InputError("sample", 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
+                                                      std::to_string(s.size()) + " primitives): a sample of another scene?");
     }
     /// Ray `i` of the probe's rays starts.
     void begin(std::size_t i) {
-        if (!sample_) return;
-        for (const Crossing& c : sample_->crossings_of(index_[i])) known_[c.prim] = c.t;
-        current_ = index_[i];
+        if (sample_) known_ = sample_->crossings_of(index_[i]);
     }
-    void end() {
-        if (!sample_) return;
-        for (const Crossing& c : sample_->crossings_of(current_)) known_[c.prim] = kInf;
-    }
+    void end() { known_ = {}; }
     /// test_prim's answer: records a hit nearer than `hit.t`.
     bool test(std::uint32_t id, const Ray& ray, Hit& hit) {
         if (!sample_) return test_prim(s_, id, ray, hit, nc_);
-        const float t = known_[id];
+        // A ray's crossings are a few (at most kMaxCrossings): a scan beats a table over the
+        // scene's primitives, which cost a pass over the scene per prediction.
+        float t = kInf;
+        for (const Crossing& c : known_)
+            if (c.prim == id) {
+                t = c.t;
+                break;
+            }
         if (t < hit.t && t < ray.tmax) {
             hit.t = t;
             hit.prim = static_cast<std::int32_t>(id);
@@ -52,8 +55,7 @@ private:
     const Scene& s_;
     const RaySample* sample_ = nullptr;
     std::span<const std::uint32_t> index_;
-    std::vector<float> known_;  // per primitive: where the current ray meets it, +inf if it does not
-    std::size_t current_ = 0;
+    std::span<const Crossing> known_;  // the current ray's crossings
     NoCount nc_;
 };
 

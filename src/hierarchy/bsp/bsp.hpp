@@ -131,6 +131,7 @@ public:
         m.split = n.split;
         m.plane = 1;
         sink.node(m, {});
+        if (sink.skip_children()) return;
         for (int side = 0; side < 2; ++side) child(n.index + side, subdiv::half(region, a, n.split, side));
     }
 };

@@ -162,7 +162,8 @@ std::vector<std::uint32_t> leaf_ids(const BvhWide::Data& d, std::uint32_t child,
     return ids;
 }
 
-/// Depth-first walk over the lanes: `visit(node_index_or_kEmpty, lane, depth)`.
+/// Depth-first walk over the lanes: `leaf(box, first, packed counts, depth)` and
+/// `interior(box, children, depth)`, which says whether to walk into the node.
 template <int W, class Leaf, class Interior>
 void walk_lanes(const std::vector<Node<W>>& nodes, Leaf&& leaf, Interior&& interior) {
     auto rec = [&](auto&& self, std::uint32_t i, int depth) -> void {
@@ -172,8 +173,7 @@ void walk_lanes(const std::vector<Node<W>>& nodes, Leaf&& leaf, Interior&& inter
             if (n.child[k] & kLeaf) {
                 leaf(box, n.child[k] & ~kLeaf, n.count[k], depth + 1);
             } else {
-                interior(box, n.count[k], depth + 1);
-                self(self, n.child[k], depth + 1);
+                if (interior(box, n.count[k], depth + 1)) self(self, n.child[k], depth + 1);
             }
         }
     };
@@ -233,7 +233,7 @@ StructureStats BvhWide::compute_structure() const {
                 s.references += n;
                 s.depth = std::max(s.depth, depth);
             },
-            [](const Box3&, std::uint32_t, int) {});
+            [](const Box3&, std::uint32_t, int) { return true; });
         s.bytes = nodes.size() * sizeof(nodes[0]);
     });
     s.bytes += d_->leaves.size() * sizeof(Data::Block);
@@ -251,6 +251,7 @@ bool BvhWide::emit_model(ModelSink& sink) const {
     root.count = d_->root_count;
     root.leaf = false;
     sink.node(root, {});
+    if (sink.skip_children()) return true;
     with_nodes(*d_, [&](const auto& nodes) {
         walk_lanes(
             nodes,
@@ -272,6 +273,7 @@ bool BvhWide::emit_model(ModelSink& sink) const {
                 m.count = n;
                 m.leaf = false;
                 sink.node(m, {});
+                return !sink.skip_children();
             });
     });
     return true;

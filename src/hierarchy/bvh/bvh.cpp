@@ -42,6 +42,7 @@ bool Bvh::emit_model(ModelSink& sink) const {
             return;
         }
         sink.node(m, {});
+        if (sink.skip_children()) return;
         for (std::uint32_t k = 0; k < n.count; ++k) self(self, n.index + k);
     };
     emit(emit, 0);

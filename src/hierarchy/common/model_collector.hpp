@@ -25,6 +25,14 @@ public:
 
     void node(const ModelNode& m, std::span<const std::uint32_t> prims) final { place(m, prims); }
 
+    /// The last node's subtree is dropped: the emitter may leave it out (then it is not waited for).
+    bool skip_children() final {
+        if (pending_ == 0) return false;
+        skip_ -= pending_;
+        pending_ = 0;
+        return true;
+    }
+
     void beam_node(const ModelNode& m, const ModelBeam& beam, std::span<const std::uint32_t> prims) final {
         const std::uint32_t at = place(m, prims);
         if (at == kDropped) return;
@@ -43,9 +51,10 @@ private:
 
     // Stores `m` in its slot and returns the slot (kDropped inside a dropped subtree).
     std::uint32_t place(const ModelNode& m, std::span<const std::uint32_t> prims) {
+        pending_ = 0;
         if (skip_ > 0) {  // inside a dropped subtree
             --skip_;
-            if (!m.leaf) skip_ += m.count;
+            if (!m.leaf) skip_ += pending_ = m.count;
             return kDropped;
         }
         std::uint32_t at = 0;
@@ -68,7 +77,7 @@ private:
             n.leaf = true;
             n.pruned = true;
             n.count = 0;
-            if (!m.leaf) skip_ += m.count;
+            if (!m.leaf) skip_ += pending_ = m.count;
         } else if (m.leaf) {
             t_.prims.insert(t_.prims.end(), prims.begin(), prims.end());
         } else {
@@ -84,7 +93,8 @@ private:
         int depth;
     };
     std::vector<Slots> open_;
-    std::uint64_t skip_ = 0;  // nodes of dropped subtrees still to arrive
+    std::uint64_t skip_ = 0;     // nodes of dropped subtrees still to arrive
+    std::uint64_t pending_ = 0;  // children of the last node, when it was dropped (skip_children)
 };
 
 }  // namespace rtcost

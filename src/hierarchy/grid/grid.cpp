@@ -260,6 +260,7 @@ bool Grid::emit_model(ModelSink& sink) const {
         root.count = 1;
         root.step = true;
         sink.node(root, {});
+        if (sink.skip_children()) return true;
         ModelNode leaf;
         leaf.region = root.region;
         leaf.count = offsets_[1] - offsets_[0];
@@ -290,6 +291,7 @@ bool Grid::emit_model(ModelSink& sink) const {
         m.hop = 0;
         m.step = root;
         sink.node(m, {});
+        if (sink.skip_children()) return;
         Range left = r, right = r;
         left.hi[axis] = mid;
         right.lo[axis] = mid;

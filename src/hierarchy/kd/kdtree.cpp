@@ -139,6 +139,7 @@ bool KdTree::emit_model(ModelSink& sink) const {
             m.box = 1;
         }
         sink.node(m, {});
+        if (sink.skip_children()) return;
         for (int side = 0; side < 2; ++side)
             self(self, n.index + side, spatial::half(region, static_cast<int>(n.axis), n.split, side));
     };

@@ -158,6 +158,7 @@ public:
         m.split = n.center.x;
         m.plane = 3;
         sink.node(m, {});
+        if (sink.skip_children()) return;
         for (int xi = 0; xi < 2; ++xi) {
             ModelNode y;
             y.region = subdiv::half(region, 0, n.center.x, xi);
@@ -167,6 +168,7 @@ public:
             y.count = 2;
             y.step = false;
             sink.node(y, {});
+            if (sink.skip_children()) continue;
             for (int yi = 0; yi < 2; ++yi) {
                 ModelNode z;
                 z.region = subdiv::half(y.region, 1, n.center.y, yi);
@@ -176,6 +178,7 @@ public:
                 z.count = 2;
                 z.step = false;
                 sink.node(z, {});
+                if (sink.skip_children()) continue;
                 for (int zi = 0; zi < 2; ++zi)
                     child(n.index + static_cast<std::uint32_t>(xi | yi << 1 | zi << 2),
                           subdiv::half(z.region, 2, n.center.z, zi));
