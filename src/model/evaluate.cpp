@@ -279,7 +279,8 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         if (sampled && h->lazy())
             for (int k = 0; k < kRayKinds; ++k) trace_rays(*h, train_kinds[k]);
         if (sample && h->lazy()) trace_rays(*h, sample->rays.rays);
-        if (visibility && h->lazy()) trace_rays(*h, visibility->rays.rays);
+        // Not the visibility sample: it would grow a lazy tree where the test rays never went, and
+        // the prediction is of the tree the test rays were measured on.
         row.structure = h->structure();
         row.lazy = h->lazy();
         row.modelled = h->modelled();
