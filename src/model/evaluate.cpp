@@ -6,6 +6,7 @@
 #include <array>
 #include <chrono>
 #include <map>
+#include <memory>
 #include <optional>
 
 #include "rtcost/error.hpp"
@@ -279,8 +280,6 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         if (sampled && h->lazy())
             for (int k = 0; k < kRayKinds; ++k) trace_rays(*h, train_kinds[k]);
         if (sample && h->lazy()) trace_rays(*h, sample->rays.rays);
-        // Not the visibility sample: it would grow a lazy tree where the test rays never went, and
-        // the prediction is of the tree the test rays were measured on.
         row.structure = h->structure();
         row.lazy = h->lazy();
         row.modelled = h->modelled();
@@ -296,8 +295,19 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
             std::optional<SegmentsPredictor> segments;
             const std::size_t nodes = row.structure.interior + row.structure.leaves;
             if (sample && wants(opt, Estimator::Segments)) segments.emplace(*h, scene, *sample, nodes);
-            std::optional<SegmentsPredictor> seen;  // over the visibility sample
-            if (visibility) seen.emplace(*h, scene, *visibility, nodes);
+            // Over the visibility sample. A lazy hierarchy exists only where rays went: the one
+            // predicted is a fresh build grown by the sample's own rays (no ray of the user's),
+            // so that the measured one stays the tree its test rays grew.
+            std::optional<SegmentsPredictor> seen;
+            std::unique_ptr<Hierarchy> grown;
+            double grow_seconds = 0;
+            if (visibility && h->lazy()) {
+                const auto grow_start = std::chrono::steady_clock::now();
+                grown = build_hierarchy(scene, req.name, req.params);
+                trace_rays(*grown, visibility->rays.rays);
+                grow_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
+            }
+            if (visibility) seen.emplace(grown ? *grown : *h, scene, *visibility, grown ? 0 : nodes);
             // A fallback on the whole tree is timed within the prediction that needed it.
             const double reached_seconds = segments ? segments->tree_seconds() : 0.0;
             for (Estimator est : opt.estimators) {
@@ -332,7 +342,8 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                     row.predictions.push_back(mix(parts, costs));
                     if (est == Estimator::Sampled) row.predictions.back().seconds += tree_seconds;
                     if (est == Estimator::Segments) row.predictions.back().seconds += reached_seconds;
-                    if (est == Estimator::Geometric && seen) row.predictions.back().seconds += seen->tree_seconds();
+                    if (est == Estimator::Geometric && seen)
+                        row.predictions.back().seconds += seen->tree_seconds() + grow_seconds;
                 }
             }
         }
