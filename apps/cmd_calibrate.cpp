@@ -24,24 +24,6 @@ struct CalibrateArgs {
     std::vector<std::string> held_out;  ///< scenes measured and predicted, not fitted
 };
 
-/// Spearman's rank correlation of x and y (no ties expected of timings).
-double spearman(const std::vector<double>& x, const std::vector<double>& y) {
-    auto ranks = [](const std::vector<double>& v) {
-        std::vector<std::size_t> idx(v.size());
-        for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = i;
-        std::sort(idx.begin(), idx.end(), [&](auto a, auto b) { return v[a] < v[b]; });
-        std::vector<double> r(v.size());
-        for (std::size_t k = 0; k < idx.size(); ++k) r[idx[k]] = static_cast<double>(k);
-        return r;
-    };
-    const std::size_t n = x.size();
-    if (n < 2) return 0;
-    const auto rx = ranks(x), ry = ranks(y);
-    double d2 = 0;
-    for (std::size_t i = 0; i < n; ++i) d2 += (rx[i] - ry[i]) * (rx[i] - ry[i]);
-    return 1 - 6 * d2 / (static_cast<double>(n) * (static_cast<double>(n) * n - 1));
-}
-
 int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     const std::vector<HierarchyRequest> names = parse_hierarchy_list(a.hierarchies, 0);
     check_output_path(a.out, "--out");
@@ -120,7 +102,7 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
             held_runs.push_back({{"run", held[i].label}, {"measured_ns_per_ray", held[i].ns_per_ray},
                                  {"predicted_ns_per_ray", held_pred[i]},
                                  {"error", (held_pred[i] - held[i].ns_per_ray) / held[i].ns_per_ray}});
-        for (const auto& [scene, v] : by_scene) rho[scene] = spearman(v.first, v.second);
+        for (const auto& [scene, v] : by_scene) rho[scene] = rank_correlation(v.first, v.second);
         json out = {{"costs_file", a.out}, {"ns_per_operation", fit}, {"rms_relative_residual", c.rms_relative},
                     {"runs", runs}};
         if (!held.empty())
@@ -150,7 +132,7 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         fmt::print("mean absolute error {:.1f}%\n", 100 * held_mae);
         for (const auto& [scene, v] : by_scene)
             fmt::print("rank agreement on {} (Spearman's rho, predicted against measured time): {:.3f}\n", scene,
-                       spearman(v.first, v.second));
+                       rank_correlation(v.first, v.second));
     }
     return 0;
 }

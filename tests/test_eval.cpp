@@ -154,5 +154,13 @@ TEST(EvalView, TheDefaultCameraFramesAThinMesh) {
     }
 }
 
+TEST(RankCorrelation, SpearmansRhoOfKnownRankings) {
+    const std::vector<double> a{1, 2, 3, 4}, same{10, 20, 30, 40}, reversed{4, 3, 2, 1}, swapped{1, 3, 2, 4};
+    EXPECT_DOUBLE_EQ(rank_correlation(a, same), 1.0);
+    EXPECT_DOUBLE_EQ(rank_correlation(a, reversed), -1.0);
+    EXPECT_DOUBLE_EQ(rank_correlation(a, swapped), 0.8);  // one adjacent swap: 1 - 6 * 2 / (4 * 15)
+    EXPECT_DOUBLE_EQ(rank_correlation(std::vector<double>{1}, std::vector<double>{2}), 0.0);
+}
+
 }  // namespace
 }  // namespace rtcost::test

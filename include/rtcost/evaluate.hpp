@@ -8,6 +8,7 @@
 #include <cstdint>
 #include <functional>
 #include <nlohmann/json.hpp>
+#include <span>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -145,6 +146,10 @@ std::string eval_header(const EvalResult& r);
 std::string eval_columns();
 std::string eval_row(const EvalRow& row);
 std::string eval_summary(const EvalResult& r, bool by_depth = false);
+
+/// Spearman's rank correlation of `x` and `y` (same length; ties ranked in order, 0 for fewer
+/// than two values): how alike a prediction ranks what was measured.
+double rank_correlation(std::span<const double> x, std::span<const double> y);
 
 std::string_view estimator_name(Estimator e);
 std::string_view preset_name(Preset p);

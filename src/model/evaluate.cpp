@@ -8,6 +8,7 @@
 #include <map>
 #include <memory>
 #include <optional>
+#include <stdexcept>
 
 #include "rtcost/error.hpp"
 #include "rtcost/sample.hpp"
@@ -23,6 +24,25 @@ std::string_view estimator_name(Estimator e) {
         case Estimator::Segments: return "segments";
     }
     return "?";
+}
+
+double rank_correlation(std::span<const double> x, std::span<const double> y) {
+    if (x.size() != y.size()) throw std::invalid_argument("rank_correlation: lengths differ");
+    auto ranks = [](std::span<const double> v) {
+        std::vector<std::size_t> idx(v.size());
+        for (std::size_t i = 0; i < idx.size(); ++i) idx[i] = i;
+        std::stable_sort(idx.begin(), idx.end(), [&](auto a, auto b) { return v[a] < v[b]; });
+        std::vector<double> r(v.size());
+        for (std::size_t k = 0; k < idx.size(); ++k) r[idx[k]] = static_cast<double>(k);
+        return r;
+    };
+    const std::size_t n = x.size();
+    if (n < 2) return 0;
+    const auto rx = ranks(x), ry = ranks(y);
+    double d2 = 0;
+    for (std::size_t i = 0; i < n; ++i) d2 += (rx[i] - ry[i]) * (rx[i] - ry[i]);
+    const double dn = static_cast<double>(n);
+    return 1 - 6 * d2 / (dn * (dn * dn - 1));
 }
 
 std::string_view preset_name(Preset p) { return p == Preset::Paper ? "paper" : "exact"; }
