@@ -346,7 +346,9 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                             parts.emplace_back(share, predict_sampled(tree, scene, train_kinds[k], o, costs));
                         } else if (est == Estimator::Segments) {
                             parts.emplace_back(share, segments->predict(sample_kinds[k], o, costs));
-                        } else if (o.query != Query::All) {
+                        } else if (o.query != Query::All && !visibility_kinds[k].empty()) {
+                            // (No stand-ins of a kind, e.g. every landing faces away from the
+                            // lights: the Cauchy-Crofton estimate below.)
                             parts.emplace_back(share, seen->predict(visibility_kinds[k], o, costs));
                             parts.back().second.estimator = "geometric";
                             parts.back().second.note = kVisibilityNote;
