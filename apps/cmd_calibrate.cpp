@@ -22,11 +22,32 @@ struct CalibrateArgs {
     int repeat = 3;
     std::string out = "costs.json";
     std::vector<std::string> held_out;  ///< scenes measured and predicted, not fitted
+    std::string terms = "ops,steps,simd,cache";
 };
+
+/// --terms: the operations always; steps, simd and cache as named.
+TimeTerms parse_terms(const std::string& text) {
+    TimeTerms t{false, false, false};
+    bool ops = false;
+    std::size_t start = 0;
+    while (start <= text.size()) {
+        const std::size_t end = std::min(text.find(',', start), text.size());
+        const std::string w = text.substr(start, end - start);
+        if (w == "ops") ops = true;
+        else if (w == "steps") t.steps = true;
+        else if (w == "simd") t.simd = true;
+        else if (w == "cache") t.cache = true;
+        else throw InputError("--terms", 0, "unknown term '" + w + "' (known: ops, steps, simd, cache)");
+        start = end + 1;
+    }
+    if (!ops) throw InputError("--terms", 0, "'ops' (the operations and the fixed cost per ray, always fitted) must be among the terms");
+    return t;
+}
 
 int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     const std::vector<HierarchyRequest> names = parse_hierarchy_list(a.hierarchies, 0);
     check_output_path(a.out, "--out");
+    const TimeTerms terms = parse_terms(a.terms);
     std::vector<CalibrationSample> samples, held;
     std::vector<std::string> held_scene;
     const std::size_t total = (a.scenes.size() + a.held_out.size()) * names.size();
@@ -50,6 +71,7 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
             s.label = req.label() + " on " + scene.name;
             s.ops = measured_cost(counted.counters);
             s.ns_per_ray = rays.rays.empty() ? 0.0 : best * 1e9 / rays.rays.size();
+            s.structure = h->structure();
             into.push_back(std::move(s));
             if (scene_of) scene_of->push_back(scene.name);
             progress.update(samples.size() + held.size());
@@ -58,7 +80,7 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     for (const std::string& spec : a.scenes) measure(spec, samples, nullptr);
     for (const std::string& spec : a.held_out) measure(spec, held, &held_scene);
     progress.finish();
-    Calibration c = calibrate(samples);
+    Calibration c = calibrate(samples, terms);
     // write_costs renames its own temporary over the path, which would replace a device or a
     // link; it writes to a private temporary here, copied onto the output by write_file_atomic.
     {
@@ -75,7 +97,7 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     // Held-out scenes: predicted time from the fitted costs against measured time, and per
     // scene the rank agreement of the hierarchies by predicted and by measured time.
     std::vector<double> held_pred;
-    for (const CalibrationSample& h : held) held_pred.push_back(c.costs.scalar(h.ops));
+    for (const CalibrationSample& h : held) held_pred.push_back(c.costs.scalar(h.ops, h.structure));
     std::map<std::string, std::pair<std::vector<double>, std::vector<double>>> by_scene;
     for (std::size_t i = 0; i < held.size(); ++i) {
         by_scene[held_scene[i]].first.push_back(held_pred[i]);
@@ -92,6 +114,10 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         for (int k = 0; k < kPrimKinds; ++k)
             fit[std::string(prim_kind_name(static_cast<PrimKind>(k)))] = c.fitted[4 + k] ? json(c.costs.prim[k]) : json(nullptr);
         fit["per_ray"] = c.costs.per_ray;
+        fit["step"] = terms.steps ? json(c.costs.step) : json(nullptr);
+        fit["box_simd"] = c.costs.box_simd >= 0 ? json(c.costs.box_simd) : json(nullptr);
+        fit["cache"] = terms.cache ? json(c.costs.cache) : json(nullptr);
+        fit["cache_bytes"] = c.costs.cache_bytes;
         json runs = json::array();
         for (std::size_t i = 0; i < samples.size(); ++i)
             runs.push_back({{"run", samples[i].label}, {"measured_ns_per_ray", samples[i].ns_per_ray},
@@ -118,6 +144,14 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         fmt::print("  {:<10} {}\n", prim_kind_name(static_cast<PrimKind>(k)),
                    c.fitted[4 + k] ? fmt::format("{:.3f}", c.costs.prim[k]) : "(not exercised)");
     fmt::print("  {:<10} {:.3f}\n", "per ray", c.costs.per_ray);
+    if (terms.steps) fmt::print("  {:<10} {:.3f} (per traversal step, besides its operations)\n", "step", c.costs.step);
+    if (terms.simd)
+        fmt::print("  {:<10} {}\n", "box simd",
+                   c.costs.box_simd >= 0 ? fmt::format("{:.3f} (per box test of a SIMD node visit)", c.costs.box_simd)
+                                         : "(no SIMD structure measured: priced as box)");
+    if (terms.cache)
+        fmt::print("  {:<10} {:.3f} (per step, per doubling of the structure beyond {})\n", "cache", c.costs.cache,
+                   human_bytes(static_cast<std::uint64_t>(c.costs.cache_bytes)));
     fmt::print("\n{:<36} {:>12} {:>12} {:>9}\n", "run", "measured ns", "fitted ns", "residual");
     for (std::size_t i = 0; i < samples.size(); ++i)
         fmt::print("{:<36} {:>12.1f} {:>12.1f} {:>+8.1f}%\n", samples[i].label, samples[i].ns_per_ray, c.predicted[i],
@@ -151,6 +185,11 @@ Subcommand setup_calibrate(CLI::App& parent, Common& common) {
         ->check(CLI::Range(1, 100))
         ->capture_default_str();
     cmd->add_option("-o,--out", a->out, "costs file to write")->capture_default_str();
+    cmd->add_option("--terms", a->terms,
+                    "time model: ops (operations and a fixed cost per ray, always), steps (ns per traversal step), "
+                    "simd (box tests of SIMD node visits priced apart), cache (ns per step per doubling of the "
+                    "structure beyond the L2 cache)")
+        ->capture_default_str();
     cmd->add_option("--held-out", a->held_out, "scenes measured and predicted with the fitted costs, not fitted (repeatable)");
     add_common(cmd, common);
     return {cmd, [a, &common] { return cmd_calibrate(*a, common); }};

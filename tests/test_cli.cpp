@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "rtcost/io.hpp"
+#include "rtcost/model.hpp"
 #include "rtcost/rays.hpp"
 #include "test_support.hpp"
 
@@ -252,6 +253,30 @@ TEST(CliModel, CalibrateWithTooFewRunsIsAClearError) {
     EXPECT_EQ(c.code, 2);
     EXPECT_NE(c.err.find("need at least"), std::string::npos) << c.err;
     EXPECT_FALSE(fs::exists(costs));
+}
+
+TEST(CliModel, CalibrateTermsChooseTheTimeModel) {
+    fs::path costs = temp_dir() / "terms.json";
+    fs::remove(costs);
+    CliRun bad = run_cli("calibrate builtin:balls:2 --terms ops,memory -q -o " + costs.string());
+    EXPECT_EQ(bad.code, 2);
+    EXPECT_NE(bad.err.find("unknown term 'memory'"), std::string::npos) << bad.err;
+    EXPECT_FALSE(fs::exists(costs));
+    const std::string runs = "calibrate builtin:balls:2 builtin:tetra:3 builtin:tetra:4 -H bvh-sah,bvh-wide,bvh-median,grid "
+                             "--size 32x32 --repeat 1 -q --json -o " + costs.string();
+    CliRun ops = run_cli(runs + " --terms ops");
+    ASSERT_EQ(ops.code, 0) << ops.err;
+    auto jo = nlohmann::json::parse(ops.out)["ns_per_operation"];
+    EXPECT_TRUE(jo["step"].is_null());
+    EXPECT_TRUE(jo["box_simd"].is_null());  // bvh-wide's box tests priced as any box test
+    CliRun all = run_cli(runs);
+    ASSERT_EQ(all.code, 0) << all.err;
+    auto ja = nlohmann::json::parse(all.out)["ns_per_operation"];
+    EXPECT_GE(ja["step"].get<double>(), 0.0);
+    EXPECT_TRUE(ja["box_simd"].is_number());  // bvh-wide was measured
+    EXPECT_GT(ja["cache_bytes"].get<double>(), 0.0);
+    rtcost::UnitCosts u = rtcost::UnitCosts::read(costs.string());
+    EXPECT_EQ(u.box_simd, ja["box_simd"].get<double>());
 }
 
 TEST(CliModel, EvalAllHierarchiesJsonHasPredictedMeasuredAndRanks) {

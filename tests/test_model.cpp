@@ -258,6 +258,69 @@ TEST(Calibrate, RecoversKnownUnitCostsAndKeepsThemNonNegative) {
     EXPECT_THROW(calibrate(std::span(runs).first(3)), InputError);
 }
 
+TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
+    // Runs timed by a known time model: per step, SIMD box tests priced apart, and a cache term
+    // for structures beyond 1 MiB. The fit must give every term back.
+    UnitCosts truth;
+    truth.box = 3; truth.plane = 5; truth.hop = 0; truth.classify = 0; truth.per_ray = 20;
+    truth.prim = {12, 30, 0, 0};
+    truth.step = 6; truth.box_simd = 0.5; truth.cache = 2; truth.cache_bytes = 1 << 20;
+    std::vector<CalibrationSample> runs;
+    for (int i = 0; i < 16; ++i) {
+        CalibrationSample s;
+        s.label = "run " + std::to_string(i);
+        s.ops.box = 4 + 5 * (i % 7);
+        s.ops.plane = (i % 3) * 6.0;
+        s.ops.steps = 3 + (i * 5) % 11;
+        s.ops.prim = {1.0 + i % 4, (i % 2) * 3.0, 0, 0};
+        s.structure.box_lanes = i % 4 == 3 ? 8 : 1;
+        s.structure.bytes = std::uint64_t(1) << (16 + i % 9);  // 64 KiB .. 16 MiB
+        s.ns_per_ray = truth.scalar(s.ops, s.structure);
+        runs.push_back(s);
+    }
+    Calibration c = calibrate(runs, {}, 1 << 20);
+    EXPECT_NEAR(c.costs.box, 3, 1e-6);
+    EXPECT_NEAR(c.costs.plane, 5, 1e-6);
+    EXPECT_NEAR(c.costs.step, 6, 1e-6);
+    EXPECT_NEAR(c.costs.box_simd, 0.5, 1e-6);
+    EXPECT_NEAR(c.costs.cache, 2, 1e-6);
+    EXPECT_NEAR(c.costs.per_ray, 20, 1e-5);
+    EXPECT_NEAR(c.rms_relative, 0, 1e-9);
+    // The same runs fitted by operations alone cannot explain them.
+    Calibration ops = calibrate(runs, {false, false, false}, 1 << 20);
+    EXPECT_GT(ops.rms_relative, 0.01);
+    EXPECT_EQ(ops.costs.step, 0);
+    EXPECT_LT(ops.costs.box_simd, 0);  // not fitted: priced as box
+    EXPECT_FALSE(ops.fitted[ops.fitted.size() - 3]);  // step
+    // No SIMD structure among the runs: box_simd stays unfitted.
+    for (auto& s : runs) s.structure.box_lanes = 1;
+    for (auto& s : runs) s.ns_per_ray = truth.scalar(s.ops, s.structure);
+    EXPECT_LT(calibrate(runs, {}, 1 << 20).costs.box_simd, 0);
+}
+
+TEST(UnitCosts, TheTimeModelPricesSimdBoxTestsAndTheCacheByTheStructure) {
+    UnitCosts u;  // unit costs: operation counts whatever the structure
+    CostVector c;
+    c.box = 10;
+    c.steps = 4;
+    c.prim[0] = 2;
+    StructureStats wide;
+    wide.box_lanes = 8;
+    wide.bytes = 64u << 20;
+    EXPECT_DOUBLE_EQ(u.scalar(c), 12.0);
+    EXPECT_DOUBLE_EQ(u.scalar(c, wide), 12.0);
+    u.calibrated = true;
+    u.box = 2; u.box_simd = 0.5; u.step = 3; u.cache = 1; u.cache_bytes = 16u << 20;
+    u.prim[0] = 10;
+    StructureStats small;  // one box at a time, within the cache
+    small.bytes = 1u << 20;
+    EXPECT_DOUBLE_EQ(u.scalar(c, small), 20 + 12 + 20);
+    // 64 MiB is two doublings beyond 16 MiB: 2 x 4 steps x 1 ns; boxes at 0.5 ns.
+    EXPECT_DOUBLE_EQ(u.scalar(c, wide), 5 + 12 + 20 + 8);
+    EXPECT_DOUBLE_EQ(u.cache_doublings(16u << 20), 0);
+    EXPECT_DOUBLE_EQ(u.cache_doublings(32u << 20), 1);
+}
+
 TEST(UnitCosts, ReadsACostsFileAndRejectsBadOnes) {
     auto dir = std::filesystem::temp_directory_path();
     auto good = dir / "rtcost_costs_good.json";
@@ -271,6 +334,17 @@ TEST(UnitCosts, ReadsACostsFileAndRejectsBadOnes) {
     c.box = 2;
     c.prim[0] = 1;
     EXPECT_DOUBLE_EQ(u.scalar(c), 15.0);
+    EXPECT_LT(u.box_simd, 0);  // a file without the time model's terms prices every box alike
+    EXPECT_EQ(u.step, 0);
+    auto full = dir / "rtcost_costs_full.json";
+    std::ofstream(full) << R"({"unit": "ns", "box": 2, "step": 4, "box_simd": 0.25, "cache": 1.5, "cache_bytes": 524288})";
+    UnitCosts f = UnitCosts::read(full.string());
+    EXPECT_EQ(f.step, 4);
+    EXPECT_EQ(f.box_simd, 0.25);
+    EXPECT_EQ(f.cache, 1.5);
+    EXPECT_EQ(f.cache_bytes, 524288);
+    std::ofstream(full) << R"({"unit": "ns", "box": 2, "step": -4})";
+    EXPECT_THROW(UnitCosts::read(full.string()), InputError);
     auto bad = dir / "rtcost_costs_bad.json";
     std::ofstream(bad) << R"({"box": -1})";
     EXPECT_THROW(UnitCosts::read(bad.string()), InputError);

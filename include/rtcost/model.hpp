@@ -30,15 +30,36 @@ struct CostVector {
 void add_scaled(CostVector& y, const CostVector& x, double w);
 
 /// Cost of one operation of each kind (default 1: pure operation counts; calibrated: ns).
+///
+/// A calibrated time model may also charge what no single operation explains: each traversal
+/// step (the loop, the stack, the fetch of a node), box tests that a node's SIMD visit makes
+/// several at once (StructureStats::box_lanes > 1: bvh-wide), and the cache misses of a structure
+/// larger than the cache. Unit costs charge none of these, so operation counts stay counts.
 struct UnitCosts {
     double box = 1, plane = 1, hop = 1, classify = 1;
     std::array<double, kPrimKinds> prim{1, 1, 1, 1};
     double per_ray = 0;       ///< fixed cost of every ray (calibrated files: setup, clip, loop)
+    double step = 0;          ///< per traversal step (CostVector::steps), besides its operations
+    /// Per box test of a structure whose box tests are SIMD (box_lanes > 1); negative: as `box`.
+    double box_simd = -1;
+    /// Per traversal step, for each doubling of the structure's bytes beyond `cache_bytes`: the
+    /// memory a step waits on once the structure no longer fits in the cache.
+    double cache = 0;
+    double cache_bytes = 1 << 20;  ///< the cache the calibrating machine's structures fit in (its L2)
     bool calibrated = false;  ///< nanoseconds fitted by `rtcost calibrate`
 
+    /// Operations, steps and the fixed cost (no structure known: box tests priced at `box`, no
+    /// cache term).
     double scalar(const CostVector& c) const;
+    /// The time model of a structure: as scalar(c), with its box tests priced at `box_simd` when
+    /// they are SIMD and the cache term for its size.
+    double scalar(const CostVector& c, const StructureStats& s) const;
+    /// The cache term's factor: log2(bytes / cache_bytes), 0 for a structure that fits.
+    double cache_doublings(std::uint64_t bytes) const;
     /// Reads a costs file (JSON `{"unit": "ns", "box": ns, "plane": ns, ..., "per_ray": ns,
-    /// "prim": {"triangle": ns, ...}}`).
+    /// "step": ns, "box_simd": ns, "cache": ns, "cache_bytes": bytes, "prim": {"triangle": ns,
+    /// ...}}`; the time model's terms are optional: `box_simd` then prices SIMD box tests as
+    /// `box`, `step` and `cache` are 0).
     static UnitCosts read(const std::string& path);
     /// Typical nanoseconds per operation, built in: what the designed hierarchies minimise
     /// unless told otherwise, because operation counts alone trade box tests for primitive
@@ -55,20 +76,35 @@ struct CalibrationSample {
     std::string label;  ///< e.g. "bvh-sah on balls"
     CostVector ops;
     double ns_per_ray = 0;
+    StructureStats structure;  ///< the structure's bytes and box lanes (the time model's extra terms)
+};
+
+/// Which terms a calibration fits besides the operations and the fixed cost per ray.
+struct TimeTerms {
+    bool steps = true;  ///< UnitCosts::step
+    bool simd = true;   ///< UnitCosts::box_simd (else SIMD box tests are priced as any box test)
+    bool cache = true;  ///< UnitCosts::cache
 };
 
 struct Calibration {
     UnitCosts costs;                ///< fitted ns per operation (calibrated = true)
     std::vector<double> predicted;  ///< fitted ns per ray for each sample
-    std::vector<bool> fitted;       ///< kinds (box, plane, hop, classify, prims..., per_ray) the data determined
+    /// Unknowns (box, plane, hop, classify, prims..., per_ray, step, box_simd, cache) the data
+    /// determined.
+    std::vector<bool> fitted;
     double rms_relative = 0;        ///< root mean square of (predicted - measured) / measured
 };
 
-/// Non-negative least squares of ns_per_ray = per_ray + sum over kinds of c_kind * ops_kind,
-/// each sample weighted by 1 / ns_per_ray (relative errors count alike). Kinds that no sample
-/// performs keep cost 0 and are reported as not fitted. Throws InputError with fewer samples
-/// than fitted unknowns.
-Calibration calibrate(std::span<const CalibrationSample> samples);
+/// Non-negative least squares of ns_per_ray = UnitCosts::scalar(ops, structure), each sample
+/// weighted by 1 / ns_per_ray (relative errors count alike). Kinds that no sample performs keep
+/// cost 0 and are reported as not fitted (box_simd: -1, priced as `box`). `cache_bytes`: the cache
+/// the cache term counts doublings beyond (0: this machine's L2). Throws InputError with fewer
+/// samples than fitted unknowns.
+Calibration calibrate(std::span<const CalibrationSample> samples, const TimeTerms& terms = {},
+                      double cache_bytes = 0);
+
+/// This machine's L2 cache in bytes (1 MiB when the system does not say).
+double cache_size_bytes();
 
 /// Writes `c` as a costs file that UnitCosts::read reads (atomically).
 void write_costs(const std::string& path, const Calibration& c, std::span<const CalibrationSample> samples);

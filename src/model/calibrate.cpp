@@ -1,12 +1,13 @@
 // Fitting nanoseconds per operation kind to measured times: the model's unit-cost table.
 // Non-negative least squares (Lawson and Hanson's active-set method) is written here because
-// the problem has at most nine unknowns and no Debian-packaged C++ library offers NNLS; the
+// the problem has at most twelve unknowns and no Debian-packaged C++ library offers NNLS; the
 // normal equations of each passive set are solved by Gaussian elimination.
 #include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <unistd.h>
 
 #include "rtcost/error.hpp"
 #include "rtcost/model.hpp"
@@ -14,16 +15,22 @@
 namespace rtcost {
 namespace {
 
-constexpr int kUnknowns = 4 + kPrimKinds + 1;  // box, plane, hop, classify, prims, per_ray
+// box, plane, hop, classify, prims, per_ray, then the time model's step, box_simd and cache.
+constexpr int kOps = 4 + kPrimKinds + 1;
+constexpr int kStep = kOps, kBoxSimd = kOps + 1, kCache = kOps + 2, kUnknowns = kOps + 3;
 
-std::array<double, kUnknowns> row_of(const CostVector& c) {
+std::array<double, kUnknowns> row_of(const CalibrationSample& s, const TimeTerms& terms, const UnitCosts& shape) {
+    const CostVector& c = s.ops;
     std::array<double, kUnknowns> r{};
-    r[0] = c.box;
+    const bool simd = terms.simd && s.structure.box_lanes > 1;
+    (simd ? r[kBoxSimd] : r[0]) = c.box;
     r[1] = c.plane;
     r[2] = c.hop;
     r[3] = c.classify;
     for (int k = 0; k < kPrimKinds; ++k) r[4 + k] = c.prim[k];
-    r[kUnknowns - 1] = 1;
+    r[kOps - 1] = 1;
+    if (terms.steps) r[kStep] = c.steps;
+    if (terms.cache) r[kCache] = c.steps * shape.cache_doublings(s.structure.bytes);
     return r;
 }
 
@@ -103,14 +110,21 @@ std::vector<double> nnls(const std::vector<std::vector<double>>& a, const std::v
 
 }  // namespace
 
-Calibration calibrate(std::span<const CalibrationSample> samples) {
+double cache_size_bytes() {
+    const long l2 = sysconf(_SC_LEVEL2_CACHE_SIZE);
+    return l2 > 0 ? double(l2) : double(1 << 20);
+}
+
+Calibration calibrate(std::span<const CalibrationSample> samples, const TimeTerms& terms, double cache_bytes) {
+    UnitCosts shape;  // carries the cache size the cache term's column is computed with
+    shape.cache_bytes = cache_bytes > 0 ? cache_bytes : cache_size_bytes();
     std::vector<bool> usable(kUnknowns, false);
     std::vector<std::vector<double>> a;
     std::vector<double> b;
     for (const CalibrationSample& s : samples) {
         if (!(s.ns_per_ray > 0) || !std::isfinite(s.ns_per_ray))
             throw InputError("calibrate", 0, "sample '" + s.label + "' has no positive time");
-        auto r = row_of(s.ops);
+        auto r = row_of(s, terms, shape);
         // Relative weighting: divide each equation by the measured time.
         std::vector<double> row(kUnknowns);
         for (int j = 0; j < kUnknowns; ++j) {
@@ -124,7 +138,8 @@ Calibration calibrate(std::span<const CalibrationSample> samples) {
     if (static_cast<int>(samples.size()) < fitted)
         throw InputError("calibrate", 0,
                          "need at least " + std::to_string(fitted) + " runs (hierarchy x scene) to fit " +
-                             std::to_string(fitted) + " unit costs, have " + std::to_string(samples.size()));
+                             std::to_string(fitted) + " unit costs, have " + std::to_string(samples.size()) +
+                             " (measure more scenes or hierarchies, or fit fewer terms)");
     std::vector<double> x = nnls(a, b, usable);
     Calibration c;
     c.costs.box = x[0];
@@ -132,12 +147,16 @@ Calibration calibrate(std::span<const CalibrationSample> samples) {
     c.costs.hop = x[2];
     c.costs.classify = x[3];
     for (int k = 0; k < kPrimKinds; ++k) c.costs.prim[k] = x[4 + k];
-    c.costs.per_ray = x[kUnknowns - 1];
+    c.costs.per_ray = x[kOps - 1];
+    c.costs.step = x[kStep];
+    c.costs.box_simd = usable[kBoxSimd] ? x[kBoxSimd] : -1;
+    c.costs.cache = x[kCache];
+    c.costs.cache_bytes = shape.cache_bytes;
     c.costs.calibrated = true;
     c.fitted = usable;
     double sum2 = 0;
     for (const CalibrationSample& s : samples) {
-        double p = c.costs.scalar(s.ops);
+        double p = c.costs.scalar(s.ops, s.structure);
         c.predicted.push_back(p);
         double rel = (p - s.ns_per_ray) / s.ns_per_ray;
         sum2 += rel * rel;
@@ -156,7 +175,10 @@ void write_costs(const std::string& path, const Calibration& c, std::span<const 
                         {"fitted_ns_per_ray", c.predicted[i]}});
     nlohmann::json j = {{"unit", "ns"},       {"box", c.costs.box},           {"plane", c.costs.plane},
                         {"hop", c.costs.hop}, {"classify", c.costs.classify}, {"prim", prim},
-                        {"per_ray", c.costs.per_ray}, {"rms_relative_residual", c.rms_relative},
+                        {"per_ray", c.costs.per_ray}, {"step", c.costs.step},
+                        {"box_simd", c.costs.box_simd >= 0 ? nlohmann::json(c.costs.box_simd) : nlohmann::json(nullptr)},
+                        {"cache", c.costs.cache}, {"cache_bytes", c.costs.cache_bytes},
+                        {"rms_relative_residual", c.rms_relative},
                         {"runs", fits}};
     // Written beside the target and renamed, so a failure leaves no half-written file.
     std::string tmp = path + ".tmp";

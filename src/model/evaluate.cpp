@@ -370,7 +370,10 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
             }
         }
         row.measured = measured_cost(counted.counters);
-        row.measured_scalar = costs.scalar(row.measured);
+        // The time model prices what the structure is as well as what it does (its SIMD box
+        // tests, its size against the cache); with unit costs this is the operation count.
+        row.measured_scalar = costs.scalar(row.measured, row.structure);
+        for (Prediction& p : row.predictions) p.scalar = costs.scalar(p.cost, row.structure);
         const Prediction* head = row.headline();
         row.error = head && row.measured_scalar > 0 ? (head->scalar - row.measured_scalar) / row.measured_scalar : 0;
         row.mrays_per_s = median > 0 ? rays->rays.size() / median / 1e6 : 0;

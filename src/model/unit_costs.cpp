@@ -10,9 +10,20 @@
 namespace rtcost {
 
 double UnitCosts::scalar(const CostVector& c) const {
-    double s = per_ray + box * c.box + plane * c.plane + hop * c.hop + classify * c.classify;
+    double s = per_ray + box * c.box + plane * c.plane + hop * c.hop + classify * c.classify + step * c.steps;
     for (int k = 0; k < kPrimKinds; ++k) s += prim[k] * c.prim[k];
     return s;
+}
+
+double UnitCosts::scalar(const CostVector& c, const StructureStats& s) const {
+    double v = scalar(c) + cache * c.steps * cache_doublings(s.bytes);
+    if (s.box_lanes > 1 && box_simd >= 0) v += (box_simd - box) * c.box;
+    return v;
+}
+
+double UnitCosts::cache_doublings(std::uint64_t bytes) const {
+    if (!(cache_bytes > 0) || double(bytes) <= cache_bytes) return 0;
+    return std::log2(double(bytes) / cache_bytes);
 }
 
 UnitCosts UnitCosts::typical() {
@@ -61,6 +72,10 @@ UnitCosts UnitCosts::read(const std::string& path) {
     get(j, "hop", u.hop);
     get(j, "classify", u.classify);
     get(j, "per_ray", u.per_ray);
+    get(j, "step", u.step);
+    if (j.contains("box_simd") && !j["box_simd"].is_null()) get(j, "box_simd", u.box_simd);
+    get(j, "cache", u.cache);
+    get(j, "cache_bytes", u.cache_bytes);
     if (j.contains("prim")) {
         for (int k = 0; k < kPrimKinds; ++k)
             get(j["prim"], std::string(prim_kind_name(static_cast<PrimKind>(k))).c_str(), u.prim[k]);

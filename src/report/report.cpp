@@ -10,7 +10,8 @@ namespace rtcost {
 
 nlohmann::json to_json(const StructureStats& s) {
     nlohmann::json j = {{"N_IN", s.interior}, {"N_V", s.leaves},  {"N_EV", s.empty_leaves}, {"N_OIV", s.references},
-                        {"depth", s.depth},   {"bytes", s.bytes}, {"seconds", s.seconds}};
+                        {"depth", s.depth},   {"bytes", s.bytes}, {"seconds", s.seconds},
+                        {"box_lanes", s.box_lanes}};
     if (!s.limits.empty()) j["limits"] = s.limits;
     return j;
 }

@@ -110,11 +110,12 @@ Designed build_design(const Scene& s, const DesignInput& in, const DesignOptions
         const Ray& ray = smp.rays.rays[r];
         return box_entry(b, inv[r], ray.tmin, std::min(ray.tmax, smp.t_end[r])) != kInf;
     };
-    // Mean cost of a primitive test and of a binary node's visit (two box tests), in the costs' units.
+    // Mean cost of a primitive test and of a binary node's visit (a step and two box tests), in the
+    // costs' units.
     double prim_cost = 0;
     for (std::uint32_t i = 0; i < s.size(); ++i) prim_cost += in.costs.prim[static_cast<int>(s.kind(i))];
     prim_cost = s.size() ? prim_cost / s.size() : 1;
-    const double trav_cost = 2 * in.costs.box;
+    const double trav_cost = in.costs.step + 2 * in.costs.box;
 
     // The sample segments reaching each node, keyed by the node's first primitive: a node is split
     // before its subtrees are built, and the left child's subtree is done before the right one's.

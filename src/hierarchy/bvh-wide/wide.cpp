@@ -237,6 +237,7 @@ StructureStats BvhWide::compute_structure() const {
         s.bytes = nodes.size() * sizeof(nodes[0]);
     });
     s.bytes += d_->leaves.size() * sizeof(Data::Block);
+    s.box_lanes = view_.width;  // one slab test for all of a node's children
     return s;
 }
 

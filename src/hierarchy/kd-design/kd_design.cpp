@@ -43,8 +43,8 @@ const Registration reg{
      }(),
      [](const Scene& s, const Params& p) -> std::unique_ptr<Hierarchy> {
          const DesignInput in = draw_design_input(s, p);
-         // An interior visit of kd-sah's traversal: one plane.
-         Designer d{{}, designing::CellRays(s, in, p.real("trust"), in.costs.plane)};
+         // An interior visit of kd-sah's traversal: a step and one plane.
+         Designer d{{}, designing::CellRays(s, in, p.real("trust"), in.costs.step + in.costs.plane)};
          d.sah.build.max_prims = 0;
          d.sah.build.max_depth = p.is("max_depth", "auto") ? default_max_depth(s.size())
                                                               : static_cast<int>(p.integer("max_depth"));

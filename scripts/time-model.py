@@ -1,0 +1,161 @@
+#!/usr/bin/env python3
+"""Writes docs/time-model.md: how well `rtcost calibrate` predicts single-thread time on scenes it
+did not fit, with operations alone and with the time model's extra terms (ns per traversal step,
+SIMD box tests priced apart, a cache term for structures larger than the L2 cache).
+
+Two-fold: the scenes are split in two halves; each half is fitted and the other half held out, so
+every scene is predicted once without having been fitted. For each fold, `calibrate --terms ops`
+and `calibrate` (every term) run side by side, one per core, each pinned to its core.
+
+Usage: python3 scripts/time-model.py [--size 128x128] [--rays spd] [--out docs/time-model.md]
+Needs build/rtcost, ../shared/scenes/spd and Debian's assimp-testmodels (the two meshes).
+"""
+import argparse
+import datetime
+import json
+import os
+import subprocess
+import sys
+import tempfile
+from concurrent.futures import ThreadPoolExecutor
+
+ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+CLI = os.environ.get("RTCOST_CLI", os.path.join(ROOT, "build", "rtcost"))
+SPD = os.path.join(ROOT, "..", "shared", "scenes", "spd")
+MESHES = {"2CylinderEngine": "/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
+          "yxa_1": "/usr/share/assimp/models/BLEND/yxa_1.blend"}
+# Each half has small and large structures, so that neither fold extrapolates the cache term.
+HALVES = (["balls", "gears", "mount", "rings", "shells", "2CylinderEngine"],
+          ["lattice", "sombrero", "teapot", "tetra", "tree", "yxa_1"])
+# Every counted hierarchy but brute force (hours on the meshes).
+HIERARCHIES = ("bsp,bsp-design,bvh-design,bvh-gs,bvh-median,bvh-sah,bvh-wide,grid,grid-design,"
+               "kd-design,kd-median,kd-sah,octree,octree-design,rc5d")
+MODELS = [("operations", "ops"), ("time model", "ops,steps,simd,cache")]
+
+
+def path_of(scene):
+    return MESHES.get(scene, os.path.join(SPD, scene + ".nff"))
+
+
+def short(name):
+    base = os.path.basename(name)
+    return os.path.splitext(base)[0]
+
+
+def cpu_name():
+    try:
+        with open("/proc/cpuinfo") as f:
+            for line in f:
+                if line.startswith("model name"):
+                    return line.split(":", 1)[1].strip()
+    except OSError:
+        pass
+    return "unknown"
+
+
+def calibrate(fit, held, terms, core, args, out):
+    cmd = ["taskset", "-c", str(core), CLI, "calibrate"] + [path_of(s) for s in fit]
+    for s in held:
+        cmd += ["--held-out", path_of(s)]
+    cmd += ["-H", HIERARCHIES, "--rays", args.rays, "--size", args.size, "--terms", terms, "-o", out, "-q", "--json"]
+    res = subprocess.run(cmd, check=True, capture_output=True, text=True)
+    return json.loads(res.stdout)
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--size", default="128x128")
+    ap.add_argument("--rays", default="spd")
+    ap.add_argument("--out", default=os.path.join(ROOT, "docs", "time-model.md"))
+    args = ap.parse_args()
+    for s in HALVES[0] + HALVES[1]:
+        if not os.path.exists(path_of(s)):
+            sys.exit(f"time-model.py: {path_of(s)} is missing")
+
+    # results[model][fold] = calibrate's JSON
+    results = {label: [None, None] for label, _ in MODELS}
+    with tempfile.TemporaryDirectory() as tmp:
+        for fold in (0, 1):
+            fit, held = HALVES[fold], HALVES[1 - fold]
+            print(f"fold {fold + 1}: fit on {', '.join(fit)}", file=sys.stderr)
+            with ThreadPoolExecutor(max_workers=2) as pool:
+                futures = {label: pool.submit(calibrate, fit, held, terms, core, args,
+                                              os.path.join(tmp, f"costs-{fold}-{core}.json"))
+                           for core, (label, terms) in enumerate(MODELS)}
+                for label, f in futures.items():
+                    results[label][fold] = f.result()
+
+    # Per scene: rho and mean absolute error under each model; per hierarchy: mean absolute error.
+    scenes = HALVES[1] + HALVES[0]  # fold 1 holds out HALVES[1]
+    per_scene = {label: {} for label, _ in MODELS}
+    per_hier = {label: {} for label, _ in MODELS}
+    for label, _ in MODELS:
+        for fold in (0, 1):
+            ho = results[label][fold]["held_out"]
+            for name, rho in ho["spearman_by_scene"].items():
+                per_scene[label].setdefault(short(name), {})["rho"] = rho
+            for r in ho["runs"]:
+                hier, scene = r["run"].split(" on ", 1)
+                per_scene[label].setdefault(short(scene), {}).setdefault("errors", []).append(abs(r["error"]))
+                per_hier[label].setdefault(hier, []).append(abs(r["error"]))
+
+    def mean(v):
+        return sum(v) / len(v) if v else float("nan")
+
+    with open(args.out + ".tmp", "w") as f:
+        f.write("# How well calibrated time predicts scenes it did not fit\n\n")
+        f.write(f"Generated by `python3 scripts/time-model.py` on {datetime.date.today()} ({cpu_name()}, "
+                f"{os.cpu_count()} cores; each calibration pinned to one core, the two of a fold side by "
+                f"side). Rays: `{args.rays}` at `--size {args.size}`. Hierarchies: {HIERARCHIES.replace(',', ', ')}.\n\n")
+        f.write("Two folds: each half of the scenes is fitted by `rtcost calibrate` while the other half is held "
+                "out (`--held-out`), so every scene below is predicted by costs fitted on other scenes only. "
+                "The error is (predicted - measured) / measured single-thread ns per ray; rho is Spearman's "
+                "rank correlation of the hierarchies' predicted and measured times on one scene.\n\n")
+        f.write("- **operations** (`--terms ops`): ns per box test, plane test, hop, classification and "
+                "primitive test by kind, and a fixed cost per ray: the model of the paper.\n"
+                "- **time model** (the default, `--terms ops,steps,simd,cache`): the same, plus ns per traversal "
+                "step (the loop, the stack, the fetch of a node), box tests of a SIMD node visit (bvh-wide) "
+                "priced apart from scalar ones, and ns per step for each doubling of the structure's bytes "
+                "beyond the L2 cache.\n\n")
+        f.write("## Summary\n\n| model | mean absolute error | rho, worst scene | rho, median | scenes at rho >= 0.95 |\n"
+                "|---|---|---|---|---|\n")
+        for label, _ in MODELS:
+            errs = [e for s in per_scene[label].values() for e in s.get("errors", [])]
+            rhos = sorted(s["rho"] for s in per_scene[label].values() if "rho" in s)
+            worst = min(per_scene[label].items(), key=lambda kv: kv[1].get("rho", 2))
+            f.write(f"| {label} | {100 * mean(errs):.1f}% | {rhos[0]:.3f} ({worst[0]}) | "
+                    f"{rhos[len(rhos) // 2]:.3f} | {sum(r >= 0.95 for r in rhos)} of {len(rhos)} |\n")
+        f.write("\n## Held-out scenes\n\n| scene | fitted on | rho, operations | rho, time model | "
+                "error, operations | error, time model |\n|---|---|---|---|---|---|\n")
+        for s in scenes:
+            fitted_on = "first half" if s in HALVES[1] else "second half"
+            a, b = per_scene[MODELS[0][0]].get(s, {}), per_scene[MODELS[1][0]].get(s, {})
+            f.write(f"| {s} | {fitted_on} | {a.get('rho', float('nan')):.3f} | {b.get('rho', float('nan')):.3f} | "
+                    f"{100 * mean(a.get('errors', [])):.1f}% | {100 * mean(b.get('errors', [])):.1f}% |\n")
+        f.write(f"\nFirst half: {', '.join(HALVES[0])}. Second half: {', '.join(HALVES[1])}.\n")
+        f.write("\n## Held-out error by hierarchy (mean absolute, over every held-out scene)\n\n"
+                "| hierarchy | operations | time model |\n|---|---|---|\n")
+        for h in sorted(per_hier[MODELS[0][0]]):
+            f.write(f"| {h} | {100 * mean(per_hier[MODELS[0][0]][h]):.1f}% | "
+                    f"{100 * mean(per_hier[MODELS[1][0]].get(h, [])):.1f}% |\n")
+        f.write("\n## Fitted costs (ns)\n\n| term | ")
+        cols = [(label, fold) for label, _ in MODELS for fold in (0, 1)]
+        f.write(" | ".join(f"{label}, fold {fold + 1}" for label, fold in cols) + " |\n|---|" +
+                "---|" * len(cols) + "\n")
+        terms = ["box", "box_simd", "plane", "hop", "classify", "triangle", "polygon", "sphere", "cone",
+                 "per_ray", "step", "cache"]
+        for t in terms:
+            cells = []
+            for label, fold in cols:
+                v = results[label][fold]["ns_per_operation"].get(t)
+                cells.append("-" if v is None else f"{v:.2f}")
+            f.write(f"| {t} | " + " | ".join(cells) + " |\n")
+        cb = results[MODELS[1][0]][0]["ns_per_operation"].get("cache_bytes")
+        f.write(f"\n`-`: not fitted (no run performs it, or the model has no such term). The cache term counts "
+                f"doublings beyond {cb / 1048576:.2f} MiB, this machine's L2 cache.\n")
+    os.replace(args.out + ".tmp", args.out)
+    print(f"wrote {args.out}", file=sys.stderr)
+
+
+if __name__ == "__main__":
+    main()
