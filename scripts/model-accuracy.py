@@ -117,7 +117,9 @@ def main():
             print(f"eval {scene} {dist} ...", file=sys.stderr)
             ev = run(["eval", path, "-H", ",".join(names), "--rays", dist, "--size", a.size,
                       "--estimator", ",".join(ESTIMATORS), "-j", "1", "-q", "--json"])
-            population = ev["rays"] + ev["sample_rays"]
+            # Every ray of the distribution: the test rays, the sample and the sampled estimator's
+            # training half (eval reports the whole count).
+            population = ev["distribution_rays"]
             per_est = {e: ([], []) for e in ESTIMATORS}
             for r in ev["results"]:
                 preds = {p["estimator"]: p for p in r["predictions"]}

@@ -111,6 +111,7 @@ struct EvalResult {
     std::string distribution;          ///< RaySet::described
     std::size_t test_rays = 0, training_rays = 0;
     std::size_t sample_rays = 0;       ///< the segments estimator's sample (disjoint from the test rays)
+    std::size_t distribution_rays = 0; ///< every ray of the distribution, before any was set apart
     double sample_seconds = 0;         ///< drawing it (once for every hierarchy)
     /// The geometric estimator's visibility sample (draw_visibility_sample; under termination).
     std::size_t visibility_rays = 0;

@@ -430,6 +430,7 @@ std::optional<RaySample> take_sample(const Scene& scene, RaySet& test, const Eva
 
 EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& opt) {
     RaySet test = make_rays(scene, spec);
+    const std::size_t whole = test.rays.size();
     RaySet train;
     double sample_seconds = 0;
     std::string split = "none";
@@ -449,10 +450,12 @@ EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& 
     }
     EvalResult r = run(scene, std::move(test), train, sample ? &*sample : nullptr, opt, split);
     r.sample_seconds = sample_seconds;
+    r.distribution_rays = whole;
     return r;
 }
 
 EvalResult evaluate(const Scene& scene, RaySet rays, const EvalOptions& opt) {
+    const std::size_t whole = rays.rays.size();
     RaySet train;
     double sample_seconds = 0;
     std::string split = "none";
@@ -463,6 +466,7 @@ EvalResult evaluate(const Scene& scene, RaySet rays, const EvalOptions& opt) {
     }
     EvalResult r = run(scene, std::move(rays), train, sample ? &*sample : nullptr, opt, split);
     r.sample_seconds = sample_seconds;
+    r.distribution_rays = whole;
     return r;
 }
 

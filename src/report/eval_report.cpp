@@ -94,6 +94,7 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
             {"preset", preset_name(r.presets.front())},
             {"training_rays", r.training_rays},
             {"sample_rays", r.sample_rays},
+            {"distribution_rays", r.distribution_rays},
             {"sample_seconds", r.sample_seconds},
             {"visibility_rays", r.visibility_rays},
             {"visibility_seconds", r.visibility_seconds},
