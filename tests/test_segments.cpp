@@ -84,6 +84,57 @@ TEST(RaySample, SameSeedSameSampleAndTheTestRaysAreTheRest) {
     EXPECT_EQ(out, rest.rays.size());
 }
 
+// The sample is stratified along the distribution's order: one ray from each run of equal
+// length, so camera rays cover the image evenly. Its mean then varies less from seed to seed
+// than a simple random sample's would (p(1 - p) / n, finite-population corrected); here p is
+// the share of pixels that see the sphereflake rather than the floor.
+TEST(RaySample, OneRayPerRunOfTheDistributionAndLessVarianceThanARandomDraw) {
+    Scene s = builtin_scene("balls", 3);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    RaySet all;
+    all.rays = camera_rays(s.camera, 64, 64);
+    all.kinds.assign(all.rays.size(), RayKind::Eye);
+    all.described = "camera 64x64";
+    const std::size_t n = 128, total = all.rays.size();
+    std::vector<char> hit(total);  // the ray's closest hit is a sphere
+    for (std::size_t i = 0; i < total; ++i) {
+        Hit h;
+        ref->closest(all.rays[i], h);
+        hit[i] = h.hit() && s.kind(static_cast<std::uint32_t>(h.prim)) == PrimKind::Sphere;
+    }
+    double p = 0;
+    for (char h : hit) p += h;
+    p /= double(total);
+    ASSERT_GT(p, 0.2);
+    ASSERT_LT(p, 0.8);
+    std::vector<double> means;
+    for (std::uint64_t seed = 1; seed <= 200; ++seed) {
+        const RaySample smp = draw_sample_from(s, all, n, seed, *ref);
+        ASSERT_EQ(smp.size(), n);
+        double m = 0;
+        std::size_t run = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            // Which ray of the distribution it is: camera rays differ by direction.
+            const auto it = std::find_if(all.rays.begin() + std::ptrdiff_t(run * total / n), all.rays.end(),
+                                         [&](const Ray& r) { return r.d == smp.rays.rays[i].d; });
+            const std::size_t k = std::size_t(it - all.rays.begin());
+            EXPECT_GE(k, i * total / n) << "ray " << i << " of seed " << seed;
+            EXPECT_LT(k, (i + 1) * total / n) << "ray " << i << " of seed " << seed;
+            run = i + 1;
+            const auto met = smp.crossings_of(i);  // nearest first
+            m += !met.empty() && s.kind(met[0].prim) == PrimKind::Sphere ? 1 : 0;
+        }
+        means.push_back(m / double(n));
+    }
+    double mean = 0, var = 0;
+    for (double m : means) mean += m / double(means.size());
+    for (double m : means) var += (m - mean) * (m - mean) / double(means.size() - 1);
+    const double random_draw = p * (1 - p) / double(n) * double(total - n) / double(total - 1);
+    EXPECT_NEAR(mean, p, 4 * std::sqrt(random_draw / double(means.size())));
+    // Over 200 draws the variance is known to about 10%: a random draw would give 1.0 +- 0.1.
+    EXPECT_LT(var, 0.8 * random_draw) << "stratified variance " << var << ", a random draw's " << random_draw;
+}
+
 TEST(RaySample, FileRoundTripsAndBadFilesAreRefused) {
     Scene s = builtin_scene("balls", 2);
     auto ref = build_hierarchy(s, "bvh-sah");
@@ -241,6 +292,7 @@ TEST(ModelSegments, EvaluatePredictsHeldOutCameraRays) {
     const EvalResult r = evaluate(s, spec, opt);
     EXPECT_EQ(r.sample_rays, 2000u);
     EXPECT_EQ(r.test_rays, 160u * 160u - 2000u);
+    EXPECT_EQ(r.distribution_rays, 160u * 160u);  // what a prediction's time is weighed against
     EXPECT_EQ(r.split, "sample");
     ASSERT_EQ(r.rows.size(), 4u);
     for (const EvalRow& row : r.rows) {

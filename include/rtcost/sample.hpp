@@ -45,8 +45,9 @@ struct RaySample {
 /// first, and the hits a BVH finds in subtrees it visits before the nearest one.
 inline constexpr std::size_t kMaxCrossings = 16;
 
-/// Draws `count` rays of the distribution `spec` names (every kind of a ray tree in its
-/// proportions, camera-based kinds from random pixels), without replacement, and finds how
+/// Draws `count` rays of the distribution `spec` names, without replacement and stratified
+/// along the distribution's order (one ray from each of `count` equal runs: every kind of a ray
+/// tree in its proportion, camera-based kinds spread evenly over the image), and finds how
 /// each one ends with `reference` (any exact hierarchy over the same scene). Shadow and
 /// ambient-occlusion rays get `occlusion`, the others `query`. Deterministic for a seed.
 RaySample draw_sample(const Scene& scene, const RaySpec& spec, std::size_t count, std::uint64_t seed,

@@ -1,4 +1,5 @@
-// Drawing a ray sample: rays of a distribution picked without replacement, and how each ends.
+// Drawing a ray sample: rays of a distribution picked without replacement (stratified along
+// their order), and how each ends.
 #include "rtcost/sample.hpp"
 
 #include <algorithm>
@@ -10,15 +11,22 @@
 namespace rtcost {
 namespace {
 
-/// The indices of a sample of `count` out of `n`, ascending: a partial Fisher-Yates shuffle.
+/// The indices of a sample of `count` out of `n`, ascending, stratified: one index drawn
+/// uniformly from each of `count` runs of consecutive indices of equal length (to one). A
+/// distribution's rays come in their order (camera-based kinds pixel by pixel, a ray tree's
+/// kinds together), so the sample covers the image evenly and each kind in its proportion,
+/// where an unstratified draw leaves clusters and gaps: the mean cost of nearby pixels is
+/// alike, so the sample's mean varies less (`tests/test_segments.cpp` measures by how much).
 std::vector<std::size_t> pick(std::size_t n, std::size_t count, std::uint64_t seed) {
     count = std::min(count, n);
-    std::vector<std::size_t> idx(n);
-    for (std::size_t i = 0; i < n; ++i) idx[i] = i;
+    std::vector<std::size_t> idx(count);
     Rng rng(seed);
-    for (std::size_t i = 0; i < count; ++i) std::swap(idx[i], idx[i + rng.engine() % (n - i)]);
-    idx.resize(count);
-    std::sort(idx.begin(), idx.end());
+    for (std::size_t j = 0; j < count; ++j) {
+        // Run j is [j n / count, (j + 1) n / count), never empty since count <= n.
+        const std::size_t lo = static_cast<std::size_t>(static_cast<unsigned __int128>(j) * n / count);
+        const std::size_t hi = static_cast<std::size_t>(static_cast<unsigned __int128>(j + 1) * n / count);
+        idx[j] = lo + static_cast<std::size_t>(rng.engine() % (hi - lo));
+    }
     return idx;
 }
 
