@@ -10,10 +10,11 @@ import argparse
 import datetime
 import json
 import os
-import platform
 import subprocess
 import sys
 import time
+
+from machine import cpu_name  # scripts/machine.py
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 SHARED = os.environ.get("RTCOST_SHARED", os.path.join(ROOT, "..", "shared"))
@@ -127,16 +128,6 @@ def targets(rows, raw_sweeps):
         out.append(f"- design time at most 10x bvh-sah's build (sample 4096 at most): {within} of {len(rows)} designs; "
                    f"worst {worst[0]:.0f}x ({worst[2]} on {worst[1]}).")
     return out
-
-
-def cpu_name():
-    try:
-        for line in open("/proc/cpuinfo"):
-            if line.startswith("model name"):
-                return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return platform.processor()
 
 
 def main():

@@ -19,6 +19,8 @@ import sys
 import tempfile
 from concurrent.futures import ThreadPoolExecutor
 
+from machine import cpu_name  # scripts/machine.py
+
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 CLI = os.environ.get("RTCOST_CLI", os.path.join(ROOT, "build", "rtcost"))
 SPD = os.path.join(ROOT, "..", "shared", "scenes", "spd")
@@ -40,17 +42,6 @@ def path_of(scene):
 def short(name):
     base = os.path.basename(name)
     return os.path.splitext(base)[0]
-
-
-def cpu_name():
-    try:
-        with open("/proc/cpuinfo") as f:
-            for line in f:
-                if line.startswith("model name"):
-                    return line.split(":", 1)[1].strip()
-    except OSError:
-        pass
-    return "unknown"
 
 
 def calibrate(fit, held, terms, core, args, out):
