@@ -24,6 +24,7 @@ struct EvalArgs {
     bool by_depth = false;
     int repeat = 0;
     int timing_threads = 1;
+    bool interleave = false;
 };
 
 /// "both" (sampled, geometric), "all", or a comma-separated list; the first is the headline.
@@ -68,6 +69,7 @@ int cmd_eval(EvalArgs& a, const Common& common) {
     opt.threads = a.threads;
     opt.timing_threads = a.timing_threads;
     opt.repeat = a.repeat;
+    opt.interleave_timing = a.interleave;
     // Each step of each hierarchy is named on a terminal while it runs (trace passes with the
     // time left), and each row is printed as it finishes, so an interrupted run keeps what it
     // measured.
@@ -134,6 +136,9 @@ Subcommand setup_eval(CLI::App& parent, Common& common) {
     eval->add_option("--repeat", a->repeat,
                      "timed passes over the test rays (default: as many as take 0.2 s); the median is reported")
         ->check(CLI::Range(0, 10000));
+    eval->add_flag("--interleave", a->interleave,
+                   "time the hierarchies in alternating passes once all are built (all kept in memory), so that "
+                   "the machine's changing load weighs on each alike");
     eval->add_option("--timing-threads", a->timing_threads, "threads of the timed passes (ns/ray is CPU time per ray)")
         ->check(CLI::Range(1, 1024))
         ->capture_default_str();

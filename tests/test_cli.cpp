@@ -279,6 +279,25 @@ TEST(CliModel, CalibrateTermsChooseTheTimeModel) {
     EXPECT_EQ(u.box_simd, ja["box_simd"].get<double>());
 }
 
+TEST(CliModel, EvalInterleavedTimesEveryRowAndCountsTheSame) {
+    const std::string run = "eval builtin:balls:2 -H bvh-sah,grid,brute --size 24x24 --repeat 3 -q --json";
+    CliRun plain = run_cli(run), inter = run_cli(run + " --interleave");
+    ASSERT_EQ(plain.code, 0) << plain.err;
+    ASSERT_EQ(inter.code, 0) << inter.err;
+    auto a = nlohmann::json::parse(plain.out)["results"], b = nlohmann::json::parse(inter.out)["results"];
+    ASSERT_EQ(a.size(), 3u);
+    ASSERT_EQ(b.size(), 3u);
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i]["hierarchy"], b[i]["hierarchy"]);
+        EXPECT_EQ(a[i]["measured"]["cost"], b[i]["measured"]["cost"]) << a[i]["hierarchy"];
+        EXPECT_EQ(b[i]["time"]["repeats"], 3) << b[i]["hierarchy"];
+        EXPECT_GT(b[i]["time"]["measured_ns_per_ray"].get<double>(), 0.0) << b[i]["hierarchy"];
+        EXPECT_GT(b[i]["mrays_per_s"].get<double>(), 0.0) << b[i]["hierarchy"];
+    }
+    // Brute force tests every primitive: slowest in either run.
+    EXPECT_EQ(b[2]["rank_time"], 3);
+}
+
 TEST(CliModel, EvalAllHierarchiesJsonHasPredictedMeasuredAndRanks) {
     CliRun e = run_cli("eval builtin:tetra:4 --rays lines --count 4000 --query all -q --json");
     ASSERT_EQ(e.code, 0) << e.err;

@@ -140,6 +140,35 @@ void rank(std::vector<EvalRow>& rows, F value, int EvalRow::*out) {
     for (std::size_t r = 0; r < idx.size(); ++r) rows[idx[r]].*out = static_cast<int>(r + 1);
 }
 
+/// The timed passes of one hierarchy: how many more to take, and the row's figures from them
+/// (medians of wall and CPU time, the spread of CPU time).
+struct PassTimes {
+    std::vector<double> wall, cpu;
+    double total = 0;
+    int threads = 1;
+
+    bool more(const EvalOptions& opt) const {
+        if (opt.repeat > 0) return static_cast<int>(wall.size()) < opt.repeat;
+        return wall.empty() || (total < opt.min_seconds && wall.size() < 1000);
+    }
+    void add(const TraceResult& r) {
+        wall.push_back(r.seconds);
+        cpu.push_back(r.cpu_seconds);
+        threads = r.threads;
+        total += r.seconds;
+    }
+    void fill(EvalRow& row, std::size_t rays) {
+        std::sort(wall.begin(), wall.end());
+        std::sort(cpu.begin(), cpu.end());
+        const double median = wall[wall.size() / 2], cpu_median = cpu[cpu.size() / 2];
+        row.repeats = static_cast<int>(wall.size());
+        row.time_spread = cpu_median > 0 ? (cpu.back() - cpu.front()) / cpu_median : 0;
+        row.mrays_per_s = median > 0 ? rays / median / 1e6 : 0;
+        row.ns_per_ray = cpu_median * 1e9 / rays;
+        row.threads = threads;
+    }
+};
+
 std::array<std::vector<Ray>, kRayKinds> by_kind(const RaySet& s) {
     std::array<std::vector<Ray>, kRayKinds> out;
     for (std::size_t i = 0; i < s.rays.size(); ++i) out[static_cast<int>(s.kinds[i])].push_back(s.rays[i]);
@@ -237,9 +266,16 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
     res.presets = opt.presets;
     res.calibrated = costs.calibrated;
 
+    // interleave_timing: what the rounds of timed passes after the loop need of each row.
+    struct Timed {
+        std::unique_ptr<Hierarchy> h;
+        RaySet subset;  // the rows' rays when not the test rays (brute force on a large scene)
+        TraceOptions to;
+    };
+    std::vector<Timed> timed_later;
     for (const HierarchyRequest& req : opt.hierarchies) {
         if (opt.on_step) opt.on_step("build " + req.label());
-        auto h = build_hierarchy(scene, req.name, req.params);
+        std::unique_ptr<Hierarchy> h = build_hierarchy(scene, req.name, req.params);
         EvalRow row;
         row.name = req.label();
         TraceOptions to;
@@ -273,27 +309,15 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         TraceResult counted = trace_ray_set(*h, *rays, to, opt.occlusion);
         row.counted = h->counted();
         // Timed passes: repeated until they add up to opt.min_seconds (or opt.repeat of them);
-        // the median is reported with the spread.
-        progress("timing");
+        // the median is reported with the spread. Interleaved: after every row is counted.
         to.count = false;
         to.threads = opt.timing_threads;
-        std::vector<double> seconds, cpu;
-        double total = 0;
-        int threads = 1;
-        const int max_repeats = opt.repeat > 0 ? opt.repeat : 1000;
-        while (static_cast<int>(seconds.size()) < max_repeats) {
-            const TraceResult timed = trace_ray_set(*h, *rays, to, opt.occlusion);
-            seconds.push_back(timed.seconds);
-            cpu.push_back(timed.cpu_seconds);
-            threads = timed.threads;
-            total += timed.seconds;
-            if (opt.repeat <= 0 && total >= opt.min_seconds) break;
+        if (!opt.interleave_timing) {
+            progress("timing");
+            PassTimes times;
+            while (times.more(opt)) times.add(trace_ray_set(*h, *rays, to, opt.occlusion));
+            times.fill(row, rays->rays.size());
         }
-        std::sort(seconds.begin(), seconds.end());
-        std::sort(cpu.begin(), cpu.end());
-        const double median = seconds[seconds.size() / 2], cpu_median = cpu[cpu.size() / 2];
-        row.repeats = static_cast<int>(seconds.size());
-        row.time_spread = cpu_median > 0 ? (cpu.back() - cpu.front()) / cpu_median : 0;
         to.progress = nullptr;
         // Structure and model tree after tracing: a lazily built hierarchy (rc5d) exists only
         // where rays went, so the training rays go through it too.
@@ -376,14 +400,34 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         for (Prediction& p : row.predictions) p.scalar = costs.scalar(p.cost, row.structure);
         const Prediction* head = row.headline();
         row.error = head && row.measured_scalar > 0 ? (head->scalar - row.measured_scalar) / row.measured_scalar : 0;
-        row.mrays_per_s = median > 0 ? rays->rays.size() / median / 1e6 : 0;
-        row.ns_per_ray = cpu_median * 1e9 / rays->rays.size();
-        row.threads = threads;
         const double n = counted.counters.rays ? static_cast<double>(counted.counters.rays) : 1;
         for (int d = 0; d < kMaxStatDepth; ++d) row.measured_visits.push_back(counted.counters.visits[d] / n);
         while (!row.measured_visits.empty() && row.measured_visits.back() == 0) row.measured_visits.pop_back();
-        if (opt.on_row) opt.on_row(row);
+        if (opt.interleave_timing) {
+            timed_later.push_back({std::move(h), rays == &subset ? std::move(subset) : RaySet{}, to});
+        } else if (opt.on_row) {
+            opt.on_row(row);
+        }
         res.rows.push_back(std::move(row));
+    }
+    if (opt.interleave_timing) {
+        // Rounds of one pass per hierarchy until every one has had its share.
+        if (opt.on_step) opt.on_step("timing (interleaved)");
+        std::vector<PassTimes> times(timed_later.size());
+        for (bool more = true; more;) {
+            more = false;
+            for (std::size_t i = 0; i < timed_later.size(); ++i) {
+                if (!times[i].more(opt)) continue;
+                const Timed& t = timed_later[i];
+                times[i].add(trace_ray_set(*t.h, t.subset.rays.empty() ? test : t.subset, t.to, opt.occlusion));
+                more = true;
+            }
+        }
+        for (std::size_t i = 0; i < timed_later.size(); ++i) {
+            const Timed& t = timed_later[i];
+            times[i].fill(res.rows[i], (t.subset.rays.empty() ? test : t.subset).rays.size());
+            if (opt.on_row) opt.on_row(res.rows[i]);
+        }
     }
     rank(res.rows, [](const EvalRow& r) { return r.modelled ? r.headline()->scalar : kInf; }, &EvalRow::rank_predicted);
     rank(res.rows, [](const EvalRow& r) { return r.counted ? r.measured_scalar : kInf; }, &EvalRow::rank_measured);
