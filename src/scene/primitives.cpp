@@ -4,6 +4,7 @@
 #include <numbers>
 
 #include "rtcost/primitive.hpp"
+#include "watertight.hpp"
 
 namespace rtcost {
 
@@ -61,9 +62,9 @@ D3 newell(const Vec3* v, std::uint32_t n) {
     return s;
 }
 
-/// The end of the watertight test with the edge values in double: the sign test, the
-/// determinant and the hit distance.
-bool finish_in_double(double u, double v, double w, float az, float bz, float cz, const Ray& ray, float& t) {
+}  // namespace
+
+bool watertight_finish_in_double(double u, double v, double w, float az, float bz, float cz, const Ray& ray, float& t) {
     if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return false;
     const double det = u + v + w;
     if (det == 0.0) return false;
@@ -73,50 +74,11 @@ bool finish_in_double(double u, double v, double w, float az, float bz, float cz
     return true;
 }
 
-}  // namespace
-
 // Watertight test (Woop, Benthin, Wald 2013): translate to the ray origin, permute so that the
 // ray's largest direction component is z, shear so that the ray is the +z axis; the 2D edge
 // functions then decide containment consistently for triangles sharing an edge. Edge values of
 // exactly zero are recomputed in double so that the sign test is exact where it matters.
-bool intersect(const Triangle& tri, const Ray& ray, float& t) {
-    const int kz = max_axis(ray.d);
-    int kx = (kz + 1) % 3, ky = (kx + 1) % 3;
-    if (ray.d[kz] < 0) std::swap(kx, ky);
-    const float sx = ray.d[kx] / ray.d[kz], sy = ray.d[ky] / ray.d[kz], sz = 1.0f / ray.d[kz];
-    const Vec3 a = tri.v0 - ray.o, b = tri.v1 - ray.o, c = tri.v2 - ray.o;
-    const float ax = a[kx] - sx * a[kz], ay = a[ky] - sy * a[kz];
-    const float bx = b[kx] - sx * b[kz], by = b[ky] - sy * b[kz];
-    const float cx = c[kx] - sx * c[kz], cy = c[ky] - sy * c[kz];
-    const float u1 = cx * by, u2 = cy * bx, v1 = ax * cy, v2 = ay * cx, w1 = bx * ay, w2 = by * ax;
-    const float u = u1 - u2, v = v1 - v2, w = w1 - w2;
-    const float az = sz * a[kz], bz = sz * b[kz], cz = sz * c[kz];
-    // Each edge value is a difference of two rounded products: its sign is certain only when it
-    // exceeds their rounding (2^-24 of each); a long thin triangle's edge values cancel far
-    // below that and would report hits beside the triangle.
-    constexpr float kRound = 1.2e-7f;
-    if (std::fabs(u) <= kRound * (std::fabs(u1) + std::fabs(u2)) ||
-        std::fabs(v) <= kRound * (std::fabs(v1) + std::fabs(v2)) ||
-        std::fabs(w) <= kRound * (std::fabs(w1) + std::fabs(w2)) || !std::isfinite(u + v + w)) {
-        // An edge (nearly) through the ray, or products beyond float's range (huge or tiny
-        // triangles): the decision in double, where the products of the sheared float
-        // coordinates are exact and each difference is rounded once, so its sign is right.
-        const double du = double(cx) * by - double(cy) * bx, dv = double(ax) * cy - double(ay) * cx,
-                     dw = double(bx) * ay - double(by) * ax;
-        return finish_in_double(du, dv, dw, az, bz, cz, ray, t);
-    }
-    if ((u < 0 || v < 0 || w < 0) && (u > 0 || v > 0 || w > 0)) return false;
-    const float det = u + v + w;
-    const float tt = (u * az + v * bz + w * cz) / det;
-    // t is the barycentric mean of az, bz, cz: with det and t both above 1e-18 the largest term
-    // is normal and the float sum is accurate. Below (tiny triangles, whose products are
-    // subnormal) or beyond float's range, the same t again in double.
-    if (!std::isfinite(tt) || !(std::fabs(det) >= 1e-18f) || !(std::fabs(tt) >= 1e-18f))
-        return finish_in_double(u, v, w, az, bz, cz, ray, t);
-    if (!(tt > ray.tmin && tt < ray.tmax)) return false;
-    t = tt;
-    return true;
-}
+bool intersect(const Triangle& tri, const Ray& ray, float& t) { return intersect(tri, ray, RayShear(ray.d), t); }
 
 bool setup_polygon(Polygon& poly, std::span<const Vec3> pool) {
     if (poly.count < 3 || poly.first + poly.count > pool.size()) return false;

@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "impl.hpp"
+#include "scene/watertight.hpp"
 
 namespace rtcost {
 
@@ -38,15 +39,17 @@ inline std::vector<LeafPrim> leaf_prims(const Scene& s, const std::vector<std::u
     return out;
 }
 
-/// test_prim for a LeafPrim: the same steps and count, on the copy of the same triangle.
+/// test_prim for a LeafPrim: the same steps and count, on the copy of the same triangle, with
+/// the ray's shear `sh` (RayShear(ray.d)) computed once per ray by the traversal.
 template <class C>
-inline bool test_prim(const Scene& scene, const LeafPrim& p, const Ray& ray, Hit& hit, C& counting) {
+inline bool test_prim(const Scene& scene, const LeafPrim& p, const Ray& ray, const RayShear& sh, Hit& hit,
+                      C& counting) {
     if (!p.as_triangle) return test_prim(scene, p.id, ray, hit, counting);
     counting.prim(p.kind);
     Ray r = ray;
     r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
     float t;
-    if (intersect(p.tri, r, t)) {
+    if (intersect(p.tri, r, sh, t)) {
         hit.t = t;
         hit.prim = static_cast<std::int32_t>(p.id);
         return true;
