@@ -155,6 +155,29 @@ TEST(Design, GridDesignIsNoWorseOnItsSampleThanTheFormula) {
     }
 }
 
+TEST(Design, KdDesignKeepsTheEmptyBonusTheModelPredictsCheaper) {
+    // empty_bonus=auto designs the tree with kd-sah's 0.2 and with 0 and keeps the one the model
+    // predicts cheaper on the sample: its cost is the smaller of the two fixed bonuses' (or
+    // kd-sah's own tree's, when cheaper still). rings: 0 is cheaper there (a sweep's finding).
+    for (const char* scene : {"builtin:balls:2", "rings"}) {
+        const std::string spec = spec_of(scene);
+        if (spec.rfind("builtin:", 0) != 0 && !std::filesystem::exists(spec)) continue;
+        const Scene s = load_scene(spec);
+        const std::vector<std::string> set{"rays=spd", "size=48x48", "sample=1024"};
+        Params p(design_param_specs(), set);
+        const DesignInput in = draw_design_input(s, p);
+        auto cost = [&](const char* bonus) {
+            std::vector<std::string> with = set;
+            with.push_back(std::string("empty_bonus=") + bonus);
+            return sample_cost(build_hierarchy(s, "kd-design", with)->model_tree(), s, in.sample, in.costs);
+        };
+        const double chosen = cost("auto"), usual = cost("0.2"), none = cost("0");
+        EXPECT_LE(chosen, std::min(usual, none) * (1 + 1e-12)) << scene;
+        if (std::string(scene) == "rings") EXPECT_LT(none, usual * 0.95) << scene;
+    }
+    EXPECT_THROW(build_hierarchy(builtin_scene("balls", 1), "kd-design", {"empty_bonus=2"}), InputError);
+}
+
 TEST(Design, EveryDesignIsNoWorseOnItsSampleThanItsYardstick) {
     // The split tests look one level down; where the model predicts the yardstick's termination
     // cheaper on the sample, the designed hierarchy is that tree (design/cheaper.hpp). So on its

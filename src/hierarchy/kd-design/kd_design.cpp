@@ -2,8 +2,11 @@
 // model, with visit probabilities from the design sample (the share of the node's sample
 // segments, clipped where each ray's search ends, that meet each child cell, blended with the
 // surface-area ratio where few reach the node), says splitting it does not pay: Subramanian and
-// Fussell's automatic termination with the user's rays instead of isotropic lines. Where the
-// model predicts kd-sah's own termination cheaper on the sample, that tree (design/cheaper.hpp).
+// Fussell's automatic termination with the user's rays instead of isotropic lines. kd-sah's plane
+// choice has one free constant that the sample can decide, the bonus of a split that cuts off
+// empty space: by default the tree is designed with no bonus and with kd-sah's 0.2 (a sweep of
+// kd-sah found either one best depending on the scene), and of the two, and of kd-sah's own
+// termination, the model's cheapest on the sample is kept (design/cheaper.hpp).
 #include "../kd/kdtree.hpp"
 #include "design/cell_rays.hpp"
 #include "design/cheaper.hpp"
@@ -37,27 +40,41 @@ const Registration reg{
          std::vector<ParamSpec> p = design_param_specs();
          p.push_back(kMaxDepthParam);
          p.push_back(ParamSpec::real("trust", "32", 0, 1e30, "sample segments at a node at which sample and surface area weigh alike"));
+         p.push_back(ParamSpec::real("empty_bonus", "auto", 0, 1,
+                                     "kd-sah's plane choice: a split with an empty side costs (1 - empty_bonus) x its SAH "
+                                     "cost; auto: designed with 0 and with 0.2, the model's cheaper on the sample kept",
+                                     {"auto"}));
          p.push_back(spatial::kAssignParam);
          p.push_back(spatial::kMailboxParam);
          return p;
      }(),
      [](const Scene& s, const Params& p) -> std::unique_ptr<Hierarchy> {
          const DesignInput in = draw_design_input(s, p);
-         // An interior visit of kd-sah's traversal: a step and one plane.
-         Designer d{{}, designing::CellRays(s, in, p.real("trust"), in.costs.step + in.costs.plane)};
-         d.sah.build.max_prims = 0;
-         d.sah.build.max_depth = p.is("max_depth", "auto") ? default_max_depth(s.size())
-                                                              : static_cast<int>(p.integer("max_depth"));
-         d.sah.build.assign = spatial::parse_assign(p);
-         const Chooser choose = [&d](const std::vector<BuildRef>& refs, const Box3& cell, int) {
-             return d.choose(refs, cell);
-         };
-         auto designed = std::make_unique<KdTree>(s, "kd-design", build_tree(s, d.sah.build, choose), p.flag("mailbox"));
-         SahOptions usual;  // kd-sah's defaults, with this tree's depth and assignment
-         usual.build = d.sah.build;
+         BuildOptions build;
+         build.max_prims = 0;
+         build.max_depth = p.is("max_depth", "auto") ? default_max_depth(s.size()) : static_cast<int>(p.integer("max_depth"));
+         build.assign = spatial::parse_assign(p);
+         const SahOptions usual_sah;  // kd-sah's defaults
+         std::vector<float> bonuses = {usual_sah.empty_bonus, 0.0f};
+         if (!p.is("empty_bonus", "auto")) bonuses = {static_cast<float>(p.real("empty_bonus"))};
+         std::unique_ptr<Hierarchy> best;
+         for (float bonus : bonuses) {
+             // An interior visit of kd-sah's traversal: a step and one plane.
+             Designer d{{}, designing::CellRays(s, in, p.real("trust"), in.costs.step + in.costs.plane)};
+             d.sah.build = build;
+             d.sah.empty_bonus = bonus;
+             const Chooser choose = [&d](const std::vector<BuildRef>& refs, const Box3& cell, int) {
+                 return d.choose(refs, cell);
+             };
+             auto designed = std::make_unique<KdTree>(s, "kd-design", build_tree(s, d.sah.build, choose), p.flag("mailbox"));
+             // A tie keeps the earlier tree: kd-sah's bonus first.
+             best = best ? designing::cheaper_on_sample(std::move(best), std::move(designed), s, in) : std::move(designed);
+         }
+         SahOptions usual = usual_sah;  // kd-sah's defaults, with this tree's depth and assignment
+         usual.build = build;
          usual.build.max_prims = 1;
          auto by_sah = std::make_unique<KdTree>(s, "kd-design", build_sah(s, usual), p.flag("mailbox"));
-         return designing::cheaper_on_sample(std::move(designed), std::move(by_sah), s, in);
+         return designing::cheaper_on_sample(std::move(best), std::move(by_sah), s, in);
      },
      kLargeScene}};  // kd-sah's O(N log^2 N) planes, each judged on the sample: 19 s for a million triangles
 
