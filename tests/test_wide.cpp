@@ -53,22 +53,27 @@ TEST(BvhWide, NodesHoldAtMostWidthChildrenAndEveryPrimitiveOnce) {
 TEST(BvhWide, BothInstructionSetsAndWidthsCountAlikeAndHitAlike) {
     Scene s = builtin_scene("tetra", 4);
     auto rays = hard_rays(s, 20000, 5);
+    // The default's triangle packs (8 lanes with AVX2, and 4 for leaves of at most four
+    // triangles) and packs of 4 throughout (tri_lanes=4) against the baseline's.
     for (const char* w : {"width=4", "width=8"}) {
         auto a = build_hierarchy(s, "bvh-wide", {w, "simd=baseline"});
-        std::vector<std::string> set{w};
-        auto b = build_hierarchy(s, "bvh-wide", set);
-        TraceOptions opt;
-        opt.count = true;
-        for (Query q : {Query::Closest, Query::Any, Query::All}) {
-            opt.query = q;
-            TraceResult ra = trace_rays(*a, rays, opt), rb = trace_rays(*b, rays, opt);
-            EXPECT_EQ(ra.counters, rb.counters) << w;
-            for (std::size_t i = 0; i < rays.size(); ++i) {
-                EXPECT_EQ(ra.hits[i].prim, rb.hits[i].prim);
-                EXPECT_EQ(ra.hits[i].t, rb.hits[i].t);
+        for (const char* lanes : {"tri_lanes=auto", "tri_lanes=4"}) {
+            std::vector<std::string> set{w, lanes};
+            auto b = build_hierarchy(s, "bvh-wide", set);
+            TraceOptions opt;
+            opt.count = true;
+            for (Query q : {Query::Closest, Query::Any, Query::All}) {
+                opt.query = q;
+                TraceResult ra = trace_rays(*a, rays, opt), rb = trace_rays(*b, rays, opt);
+                EXPECT_EQ(ra.counters, rb.counters) << w << " " << lanes;
+                for (std::size_t i = 0; i < rays.size(); ++i) {
+                    EXPECT_EQ(ra.hits[i].prim, rb.hits[i].prim);
+                    EXPECT_EQ(ra.hits[i].t, rb.hits[i].t);
+                }
             }
         }
     }
+    EXPECT_THROW(build_hierarchy(s, "bvh-wide", {"simd=baseline", "tri_lanes=8"}), InputError);
 }
 
 TEST(BvhWide, ARayMissingTheRootPaysOneBoxTestAndNoStep) {

@@ -26,14 +26,26 @@ bool cpu_has_avx2() {
 
 namespace avx2 {
 
+// Four lanes: a 4-wide node's boxes, and triangle packs of four (every leaf's with tri_lanes=4,
+// else a leaf's of at most four triangles, which would fill a pack of eight poorly and read
+// twice its bytes).
 struct P4 {
     __m128 v;
     static P4 load(const float* p) { return {_mm_load_ps(p)}; }
     static P4 splat(float x) { return {_mm_set1_ps(x)}; }
     static P4 sub(P4 a, P4 b) { return {_mm_sub_ps(a.v, b.v)}; }
     static P4 mul(P4 a, P4 b) { return {_mm_mul_ps(a.v, b.v)}; }
+    static P4 add(P4 a, P4 b) { return {_mm_add_ps(a.v, b.v)}; }
+    static P4 div(P4 a, P4 b) { return {_mm_div_ps(a.v, b.v)}; }
+    static __m128 lt(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_LT_OQ); }
+    static __m128 gt(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_GT_OQ); }
+    static __m128 eq(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_EQ_OQ); }
+    static __m128 neq(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_NEQ_UQ); }  // true when unordered
+    static __m128 mand(__m128 a, __m128 b) { return _mm_and_ps(a, b); }
+    static __m128 mor(__m128 a, __m128 b) { return _mm_or_ps(a, b); }
+    static unsigned bits(__m128 m) { return static_cast<unsigned>(_mm_movemask_ps(m)); }
     static P4 max(P4 a, P4 b) { return {_mm_max_ps(a.v, b.v)}; }  // a > b ? a : b
-    static P4 min(P4 a, P4 b) { return {_mm_min_ps(a.v, b.v)}; }
+    static P4 min(P4 a, P4 b) { return {_mm_min_ps(a.v, b.v)}; }  // a < b ? a : b
     static unsigned le(P4 a, P4 b) { return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(a.v, b.v))); }
     void store(float* p) const { _mm_store_ps(p, v); }
 };
@@ -63,7 +75,10 @@ struct P8 {
 
 #include "walk.inc"
 
-Walks make(int width) { return width == 8 ? make_walks<P8, 8, P8, 8>() : make_walks<P4, 4, P8, 8>(); }
+Walks make(int width, int tri_lanes) {
+    if (tri_lanes == 4) return width == 8 ? make_walks<P8, 8, P4, 4, P4>() : make_walks<P4, 4, P4, 4, P4>();
+    return width == 8 ? make_walks<P8, 8, P8, 8, P4>() : make_walks<P4, 4, P8, 8, P4>();
+}
 
 }  // namespace avx2
 
@@ -73,7 +88,7 @@ Walks make(int width) { return width == 8 ? make_walks<P8, 8, P8, 8>() : make_wa
 #pragma GCC pop_options
 #endif
 
-Walks walks_avx2(int width) { return avx2::make(width); }
+Walks walks_avx2(int width, int tri_lanes) { return avx2::make(width, tri_lanes); }
 
 }  // namespace rtcost::wide
 
@@ -81,7 +96,7 @@ Walks walks_avx2(int width) { return avx2::make(width); }
 
 namespace rtcost::wide {
 bool cpu_has_avx2() { return false; }
-Walks walks_avx2(int width) { return walks_baseline(width); }
+Walks walks_avx2(int width, int) { return walks_baseline(width); }
 }  // namespace rtcost::wide
 
 #endif

@@ -96,7 +96,8 @@ struct P8 {
 }  // namespace base
 
 Walks walks_baseline(int width) {
-    return width == 8 ? base::make_walks<base::P8, 8, base::P4, 4>() : base::make_walks<base::P4, 4, base::P4, 4>();
+    return width == 8 ? base::make_walks<base::P8, 8, base::P4, 4, base::P4>()
+                      : base::make_walks<base::P4, 4, base::P4, 4, base::P4>();
 }
 
 }  // namespace rtcost::wide

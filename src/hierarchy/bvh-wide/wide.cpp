@@ -100,43 +100,39 @@ std::uint32_t collapse(const bvh::BvhData& bd, std::vector<Node<W>>& out) {
     return static_cast<std::uint32_t>(root_count);
 }
 
-/// Appends the leaf over `ids` to the arena: its triangles K to a pack, then its other
-/// primitives. Sets the lane's `child` and `count` as View describes.
+/// Triangle `id` as a pack stores it: a triangle, or a three-vertex polygon (which
+/// intersect(Polygon) tests as exactly this triangle); false for other primitives.
+bool pack_triangle(const Scene& s, std::uint32_t id, Triangle& t) {
+    const PrimRef& r = s.prims[id];
+    if (r.kind == PrimKind::Triangle) {
+        t = s.triangles[r.index];
+        return true;
+    }
+    if (r.kind == PrimKind::Polygon && s.polygons[r.index].count == 3) {
+        const Vec3* v = s.polygon_vertices.data() + s.polygons[r.index].first;
+        t = Triangle{v[0], v[1], v[2]};
+        return true;
+    }
+    return false;
+}
+
+/// Appends a leaf to the arena: `tris` K to a pack, then `others`. Sets the lane's `child` and
+/// `count` as View describes.
 template <int K>
-void append_leaf(std::vector<BvhWide::Data::Block>& arena, const Scene& s, std::span<const std::uint32_t> ids,
-                 std::uint32_t& child, std::uint32_t& count) {
-    // Reused from leaf to leaf: a build appends some 100,000 leaves.
-    thread_local std::vector<std::uint32_t> tris, others;
-    tris.clear(), others.clear();
-    auto triangle = [&](std::uint32_t id, Triangle& t) {
-        const PrimRef& r = s.prims[id];
-        if (r.kind == PrimKind::Triangle) {
-            t = s.triangles[r.index];
-            return true;
-        }
-        if (r.kind == PrimKind::Polygon && s.polygons[r.index].count == 3) {
-            // intersect(Polygon) tests a three-vertex polygon as exactly this triangle.
-            const Vec3* v = s.polygon_vertices.data() + s.polygons[r.index].first;
-            t = Triangle{v[0], v[1], v[2]};
-            return true;
-        }
-        return false;
-    };
-    Triangle t;
-    for (std::uint32_t id : ids) (triangle(id, t) ? tris : others).push_back(id);
-    if (tris.size() > 0xffff || others.size() > 0xffff)
-        throw InputError("bvh-wide", 0, "a leaf of more than 65535 primitives of one kind");
+void append_packs(std::vector<BvhWide::Data::Block>& arena, const Scene& s, const std::vector<std::uint32_t>& tris,
+                  const std::vector<std::uint32_t>& others, std::uint32_t& child, std::uint32_t& count) {
     const std::size_t packs = (tris.size() + K - 1) / K;
     const std::size_t bytes = packs * sizeof(TriPack<K>) + others.size() * sizeof(Other);
     const std::size_t offset = arena.size();
     if (offset >= kLeaf) throw InputError("bvh-wide", 0, "too many leaves");
     arena.resize(offset + (bytes + kLeafAlign - 1) / kLeafAlign);
     auto* pk = reinterpret_cast<TriPack<K>*>(arena.data() + offset);
+    Triangle t;
     for (std::size_t p = 0; p < packs; ++p) {
         TriPack<K>& q = *new (pk + p) TriPack<K>{};
         for (int l = 0; l < K && p * K + l < tris.size(); ++l) {
             const std::uint32_t id = tris[p * K + l];
-            triangle(id, t);
+            pack_triangle(s, id, t);
             const Vec3 v[3] = {t.v0, t.v1, t.v2};
             for (int i = 0; i < 3; ++i)
                 for (int a = 0; a < 3; ++a) q.v[3 * i + a][l] = v[i][a];
@@ -150,15 +146,46 @@ void append_leaf(std::vector<BvhWide::Data::Block>& arena, const Scene& s, std::
     count = static_cast<std::uint32_t>(tris.size()) | static_cast<std::uint32_t>(others.size()) << 16;
 }
 
+/// The pack width of a leaf of `ntri` triangles in a tree of `K`-lane packs: a leaf of at most
+/// four is one pack of four (eight lanes would be mostly empty and twice the bytes to read).
+template <int K>
+constexpr int pack_lanes(std::uint32_t ntri) {
+    return K > 4 && ntri <= 4 ? 4 : K;
+}
+
+/// Appends the leaf over `ids` to the arena: its triangles in packs (pack_lanes), then its
+/// other primitives.
+template <int K>
+void append_leaf(std::vector<BvhWide::Data::Block>& arena, const Scene& s, std::span<const std::uint32_t> ids,
+                 std::uint32_t& child, std::uint32_t& count) {
+    // Reused from leaf to leaf: a build appends some 100,000 leaves.
+    thread_local std::vector<std::uint32_t> tris, others;
+    tris.clear(), others.clear();
+    Triangle t;
+    for (std::uint32_t id : ids) (pack_triangle(s, id, t) ? tris : others).push_back(id);
+    if (tris.size() > 0xffff || others.size() > 0xffff)
+        throw InputError("bvh-wide", 0, "a leaf of more than 65535 primitives of one kind");
+    if (pack_lanes<K>(static_cast<std::uint32_t>(tris.size())) == 4) append_packs<4>(arena, s, tris, others, child, count);
+    else append_packs<K>(arena, s, tris, others, child, count);
+}
+
+/// A leaf's ids read back from packs of `K`.
+template <int K>
+void read_leaf(const std::byte* at, std::uint32_t ntri, std::uint32_t nother, std::vector<std::uint32_t>& ids) {
+    const auto* pk = reinterpret_cast<const TriPack<K>*>(at);
+    for (std::uint32_t i = 0; i < ntri; ++i) ids.push_back(pk[i / K].id[i % K]);
+    const auto* o = reinterpret_cast<const Other*>(pk + (ntri + K - 1) / K);
+    for (std::uint32_t k = 0; k < nother; ++k) ids.push_back(o[k].id);
+}
+
 /// The primitive ids of a leaf lane, read back from the arena.
 template <int K>
 std::vector<std::uint32_t> leaf_ids(const BvhWide::Data& d, std::uint32_t child, std::uint32_t count) {
     std::vector<std::uint32_t> ids;
     const std::uint32_t ntri = count & 0xffffu, nother = count >> 16;
-    const auto* pk = reinterpret_cast<const TriPack<K>*>(d.leaves.data() + (child & ~kLeaf));
-    for (std::uint32_t i = 0; i < ntri; ++i) ids.push_back(pk[i / K].id[i % K]);
-    const auto* o = reinterpret_cast<const Other*>(pk + (ntri + K - 1) / K);
-    for (std::uint32_t k = 0; k < nother; ++k) ids.push_back(o[k].id);
+    const auto* at = reinterpret_cast<const std::byte*>(d.leaves.data() + (child & ~kLeaf));
+    if (pack_lanes<K>(ntri) == 4) read_leaf<4>(at, ntri, nother, ids);
+    else read_leaf<K>(at, ntri, nother, ids);
     return ids;
 }
 
@@ -287,6 +314,8 @@ std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p) {
     const std::string& simd = p.str("simd");
     if (simd == "avx2" && !avx2) throw InputError("bvh-wide", 0, "simd=avx2: this CPU does not run AVX2");
     const bool use_avx2 = avx2 && simd != "baseline";
+    if (p.is("tri_lanes", "8") && !use_avx2)
+        throw InputError("bvh-wide", 0, "tri_lanes=8: packs of eight are tested with AVX2 only (here: simd=baseline or a CPU without it)");
     const std::string& w = p.str("width");
     auto d = std::make_unique<BvhWide::Data>();
     d->width = w == "4" ? 4 : w == "8" ? 8 : (use_avx2 ? 8 : 4);
@@ -300,7 +329,7 @@ std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p) {
         d->root_box = bd.nodes[0].box;
         d->root_count = d->width == 8 ? collapse<8>(bd, d->n8) : collapse<4>(bd, d->n4);
     }
-    d->tri_lanes = use_avx2 ? 8 : 4;
+    d->tri_lanes = use_avx2 && !p.is("tri_lanes", "4") ? 8 : 4;
     const std::string& ao = p.str("any_order");
     d->any_order = ao == "nearest" ? kAnyNearest : kAnyLeaves;
     if (d->width == 8) {
@@ -310,7 +339,7 @@ std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p) {
         if (d->tri_lanes == 8) pack_leaves<4, 8>(*d, d->n4, bd, s);
         else pack_leaves<4, 4>(*d, d->n4, bd, s);
     }
-    const Walks walks = use_avx2 ? walks_avx2(d->width) : walks_baseline(d->width);
+    const Walks walks = use_avx2 ? walks_avx2(d->width, d->tri_lanes) : walks_baseline(d->width);
     return std::make_unique<BvhWide>(s, std::move(d), walks);
 }
 
@@ -324,6 +353,8 @@ const Registration reg{
       ParamSpec::choice("any_order", "leaves", {"leaves", "nearest"},
                         "order of the children met in any-hit (occlusion) queries: leaf children first, then "
                         "nearest first; or nearest first, as closest-hit queries"),
+      ParamSpec::choice("tri_lanes", "auto", {"auto", "4", "8"},
+                        "triangles tested at once: 4, 8 (AVX2 only), or auto (8 where the CPU runs AVX2, else 4)"),
       ParamSpec::integer("max_prims", "16", 1, 64, "largest leaf of the SAH tree collapsed (bigger nodes are always split)"),
       ParamSpec::integer("bins", "16", 2, 256, "SAH bins per axis"),
       ParamSpec::real("c_trav", "4", 0, 1e6,
@@ -334,7 +365,8 @@ const Registration reg{
      {{"width=4"}, kTestHits | kTestSampled},
      {{"any_order=nearest"}, kTestHits | kTestSampled},
      {{"width=8", "simd=baseline", "max_prims=1"}, kTestHits},
-     {{"width=4", "simd=baseline", "max_prims=8"}, kTestHits}}};
+     {{"width=4", "simd=baseline", "max_prims=8"}, kTestHits},
+     {{"tri_lanes=4"}, kTestHits}}};
 
 }  // namespace
 }  // namespace rtcost::wide

@@ -56,14 +56,16 @@ inline constexpr std::size_t kLeafAlign = 32;
 /// What a traversal reads: the nodes of one width, and the leaves in leaf order. A leaf lane's
 /// `child` is kLeaf | (its offset in `leaves` / kLeafAlign) and its `count` packs the
 /// triangles (low 16 bits) and the other primitives (high 16 bits). At that offset lie
-/// ceil(triangles / tri_lanes) TriPack<tri_lanes>, then the other primitives as Other records.
+/// ceil(triangles / K) TriPack<K>, then the other primitives as Other records, where K is
+/// tri_lanes, but 4 for a leaf of at most four triangles (a pack of eight would be mostly empty
+/// lanes, and twice the bytes to read).
 struct View {
     const void* nodes = nullptr;
     int width = 8;
     Box3 root_box;
     std::uint32_t root_count = 0;       ///< lanes used in the root
     const std::byte* leaves = nullptr;
-    int tri_lanes = 4;  ///< 4 for the baseline traversal, 8 for AVX2
+    int tri_lanes = 4;  ///< 4 for the baseline traversal, 4 or 8 for AVX2
     const Scene* scene = nullptr;
     /// Order of the children met in any-hit queries: AnyOrder.
     int any_order = 0;
@@ -84,10 +86,10 @@ struct Walks {
     WalkFn<Count> counted[3] = {};
 };
 
-/// The traversals compiled for the baseline (SSE2 on x86-64, plain loops elsewhere) and, on
-/// x86-64, for AVX2; `width` is 4 or 8.
+/// The traversals compiled for the baseline (SSE2 on x86-64, plain loops elsewhere; triangle
+/// packs of 4) and, on x86-64, for AVX2 (packs of `tri_lanes`, 4 or 8); `width` is 4 or 8.
 Walks walks_baseline(int width);
-Walks walks_avx2(int width);
+Walks walks_avx2(int width, int tri_lanes);
 /// Whether this CPU (and its operating system) runs AVX2.
 bool cpu_has_avx2();
 
