@@ -18,7 +18,7 @@ struct Candidate {
     double cost = 0;
 };
 
-/// The search: the hetero formula's cell shape at densities 1/8 to 8 cells per primitive, then
+/// The search: the hetero formula's cell shape at densities 1/8 to 64 cells per primitive, then
 /// coordinate descent on each axis (factors 3/4 and 4/3) from the cheapest, until no step
 /// pays. At most `max_cells` cells per candidate. Returns every candidate, cheapest first.
 std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, spatial::Assign assign, bool mailbox,
