@@ -18,6 +18,7 @@
 #include "rtcost/io.hpp"
 #include "rtcost/model.hpp"
 #include "rtcost/rays.hpp"
+#include "rtcost/sample.hpp"
 #include "rtcost/trace.hpp"
 
 using namespace rtcost;
@@ -193,6 +194,41 @@ void model_bench(benchmark::State& state, std::string scene, std::string hierarc
     state.counters["share_pct"] = trace > 0 ? 100 * estimate / trace : 0;
 }
 
+/// The segments estimator for one hierarchy: materialising what its sample reaches and the
+/// replay, from a sample of 2% of the scene's `spd` rays (at most 4,096, as `rtcost eval` draws
+/// it), after the build and the draw. Counters as model_bench's: the traversal of every `spd` ray
+/// (`spd_trace_ms`) and the prediction's share of it (`share_pct`; the target is 2%).
+void segments_bench(benchmark::State& state, std::string scene, std::string hierarchy) {
+    Workload& w = workload(scene);
+    auto h = build_hierarchy(w.scene, hierarchy);
+    if (!w.spd) {
+        RaySpec spec;
+        spec.name = "spd";
+        w.spd = std::make_unique<RaySet>(make_rays(w.scene, spec));
+    }
+    TraceOptions t;
+    t.threads = 1;
+    if (h->lazy()) trace_ray_set(*h, *w.spd, t);
+    const double trace = trace_ray_set(*h, *w.spd, t).seconds;
+    auto reference = build_hierarchy(w.scene, "bvh-sah");
+    const std::size_t n = std::clamp<std::size_t>(w.spd->rays.size() / 50, 1, 4096);
+    const RaySample sample = draw_sample_from(w.scene, *w.spd, n, 1, *reference);
+    std::vector<std::uint32_t> all(sample.size());
+    for (std::uint32_t i = 0; i < all.size(); ++i) all[i] = i;
+    double seconds = 0;
+    for (auto _ : state) {
+        const auto start = std::chrono::steady_clock::now();
+        SegmentsPredictor p(*h, w.scene, sample);
+        Prediction pr = p.predict(all, ModelOptions{});
+        seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        benchmark::DoNotOptimize(pr.scalar);
+    }
+    const double estimate = state.iterations() > 0 ? seconds / state.iterations() : 0;
+    state.counters["spd_trace_ms"] = trace * 1e3;
+    state.counters["share_pct"] = trace > 0 ? 100 * estimate / trace : 0;
+    state.counters["sample"] = static_cast<double>(n);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -202,10 +238,14 @@ int main(int argc, char** argv) {
     for (const HierarchyInfo* info : hierarchies()) all.push_back(info->name);
     for (const auto& s : model_scenes)
         for (const auto& h : all)
-            if (h != "embree" && h != "brute")
+            if (h != "embree" && h != "brute") {
                 benchmark::RegisterBenchmark(("model/" + s + "/" + h).c_str(), model_bench, s, h)
                     ->Unit(benchmark::kMillisecond)
                     ->MinTime(0.2);
+                benchmark::RegisterBenchmark(("segments/" + s + "/" + h).c_str(), segments_bench, s, h)
+                    ->Unit(benchmark::kMillisecond)
+                    ->MinTime(0.2);
+            }
     // Traversal against Embree on the rays that matter, one thread and all cores (names end in
     // /1t and /mt: run the /1t ones pinned to one core), on mount-s8 and two tessellated meshes;
     // `random` rays (most miss) once per scene. Builds on one thread.
