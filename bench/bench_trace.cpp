@@ -165,6 +165,21 @@ void build_bench(benchmark::State& state, std::string scene, std::string hierarc
     state.counters["prims"] = static_cast<double>(w.scene.size());
 }
 
+/// Single-thread seconds of tracing the scene's `spd` rays (the scene's own camera size, as
+/// `rtcost trace --rays spd -j 1 --no-count`) through `h`, after a first pass that grows a lazy
+/// hierarchy; the rays are made once per workload.
+double spd_trace_seconds(Workload& w, const Hierarchy& h) {
+    if (!w.spd) {
+        RaySpec spec;
+        spec.name = "spd";
+        w.spd = std::make_unique<RaySet>(make_rays(w.scene, spec));
+    }
+    TraceOptions t;
+    t.threads = 1;
+    if (h.lazy()) trace_ray_set(h, *w.spd, t);
+    return trace_ray_set(h, *w.spd, t).seconds;
+}
+
 /// The geometric estimator alone (one pass over the hierarchy's nodes), after the build: the cost
 /// of predicting instead of measuring. Counters: the single-thread time to trace the scene's
 /// `spd` rays through the same hierarchy in the same process (`spd_trace_ms`, traversal alone, as
@@ -172,15 +187,7 @@ void build_bench(benchmark::State& state, std::string scene, std::string hierarc
 void model_bench(benchmark::State& state, std::string scene, std::string hierarchy) {
     Workload& w = workload(scene);
     auto h = build_hierarchy(w.scene, hierarchy);
-    if (!w.spd) {
-        RaySpec spec;
-        spec.name = "spd";
-        w.spd = std::make_unique<RaySet>(make_rays(w.scene, spec));
-    }  // the scene's own camera size, as `rtcost trace --rays spd`
-    TraceOptions t;
-    t.threads = 1;
-    if (h->lazy()) trace_ray_set(*h, *w.spd, t);  // the first pass builds what the rays need
-    const double trace = trace_ray_set(*h, *w.spd, t).seconds;
+    const double trace = spd_trace_seconds(w, *h);
     ModelOptions opt;
     double seconds = 0;
     for (auto _ : state) {
@@ -201,15 +208,7 @@ void model_bench(benchmark::State& state, std::string scene, std::string hierarc
 void segments_bench(benchmark::State& state, std::string scene, std::string hierarchy) {
     Workload& w = workload(scene);
     auto h = build_hierarchy(w.scene, hierarchy);
-    if (!w.spd) {
-        RaySpec spec;
-        spec.name = "spd";
-        w.spd = std::make_unique<RaySet>(make_rays(w.scene, spec));
-    }
-    TraceOptions t;
-    t.threads = 1;
-    if (h->lazy()) trace_ray_set(*h, *w.spd, t);
-    const double trace = trace_ray_set(*h, *w.spd, t).seconds;
+    const double trace = spd_trace_seconds(w, *h);
     auto reference = build_hierarchy(w.scene, "bvh-sah");
     const std::size_t n = std::clamp<std::size_t>(w.spd->rays.size() / 50, 1, 4096);
     const RaySample sample = draw_sample_from(w.scene, *w.spd, n, 1, *reference);

@@ -122,12 +122,7 @@ private:
                 const Node& n = nodes[e.node];
                 if (n.leaf) {
                     counting.leaf(e.depth, n.count);
-                    for (const LeafPrim* p = &prims_[n.index]; p != &prims_[n.index] + n.count; ++p) {
-                        if (test_prim(*scene_, *p, ray, shear, hit, counting)) {
-                            found = true;
-                            if constexpr (Q == Query::Any) return true;
-                        }
-                    }
+                    if (test_leaf<C, Q>(n.index, n.count, ray, shear, hit, counting, found)) return true;
                     goto pop;
                 }
                 counting.interior(e.depth);
@@ -141,12 +136,7 @@ private:
                     const float tb = box_entry(nodes[n.index + 1].box, ri, ray.tmin, limit);
                     Entry a{n.index, ta, e.depth + 1}, b{n.index + 1, tb, e.depth + 1};
                     if constexpr (kOrdered) {
-                        if (Q == Query::Any && any_leaves_first_) {
-                            const bool la = nodes[a.node].leaf, lb = nodes[b.node].leaf;
-                            if (la != lb ? lb : !(ta < tb)) std::swap(a, b);
-                        } else if (tb < ta) {
-                            std::swap(a, b);
-                        }
+                        if (second_first<Q>(nodes[a.node].leaf, nodes[b.node].leaf, ta, tb)) std::swap(a, b);
                     }
                     if (a.t != kInf) {
                         if (b.t != kInf) {
@@ -225,13 +215,7 @@ private:
                 }
                 if (e.ref.leaf) {
                     counting.leaf(e.depth, e.ref.count);
-                    const LeafPrim* first = prims_.data() + e.ref.index;
-                    for (const LeafPrim* p = first; p != first + e.ref.count; ++p) {
-                        if (test_prim(*scene_, *p, ray, shear, hit, counting)) {
-                            found = true;
-                            if constexpr (Q == Query::Any) return true;
-                        }
-                    }
+                    if (test_leaf<C, Q>(e.ref.index, e.ref.count, ray, shear, hit, counting, found)) return true;
                     goto pop;
                 }
                 counting.interior(e.depth);
@@ -243,12 +227,7 @@ private:
                 pair_entry(n, pr, ray.tmin, limit, ta, tb);
                 Entry a{n.child[0], ta, e.depth + 1}, b{n.child[1], tb, e.depth + 1};
                 if constexpr (kOrdered) {
-                    if (Q == Query::Any && any_leaves_first_) {
-                        const bool la = a.ref.leaf, lb = b.ref.leaf;
-                        if (la != lb ? lb : !(ta < tb)) std::swap(a, b);
-                    } else if (tb < ta) {
-                        std::swap(a, b);
-                    }
+                    if (second_first<Q>(a.ref.leaf, b.ref.leaf, ta, tb)) std::swap(a, b);
                 }
                 if (a.t != kInf) {
                     if (b.t != kInf) {
@@ -269,6 +248,28 @@ private:
             e = stack[--sp];
         }
         return found;
+    }
+
+    /// Tests the leaf's `count` primitives from prims_[first]; true when an any-hit query ends.
+    template <class C, Query Q>
+    bool test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, const RayShear& shear, Hit& hit, C& counting,
+                   bool& found) const {
+        for (const LeafPrim* p = prims_.data() + first; p != prims_.data() + first + count; ++p) {
+            if (test_prim(*scene_, *p, ray, shear, hit, counting)) {
+                found = true;
+                if constexpr (Q == Query::Any) return true;
+            }
+        }
+        return false;
+    }
+
+    /// An ordered visit of a binary node: whether the second child (a leaf if `lb`, entered at
+    /// `tb`) goes first. Nearest first; any_leaves_first: a leaf child first, then the nearest,
+    /// a tie to the second child.
+    template <Query Q>
+    bool second_first(bool la, bool lb, float ta, float tb) const {
+        if (Q == Query::Any && any_leaves_first_) return la != lb ? lb : !(ta < tb);
+        return tb < ta;
     }
 
     /// Incoherent rays wait on memory: what a visit of `n` reads first, fetched ahead.
