@@ -14,6 +14,8 @@
 
 namespace rtcost {
 
+class Hierarchy;
+
 /// One eye ray per pixel centre of a `width` x `height` image from the scene's camera. The
 /// direction is not normalised: its component along the view axis is 1, so tmin = hither clips
 /// at the hither plane exactly.
@@ -98,6 +100,13 @@ std::vector<std::string> distribution_names();
 struct RayMaking {
     int threads = 0;  ///< 0: all cores (distributions made by tracing)
     std::function<void(std::size_t done, std::size_t total)> progress;  ///< rows, for those that trace
+    /// An exact hierarchy over the scene for the distributions made by tracing (hits are exact,
+    /// so the rays are the same whichever); null: they build a bvh-sah of their own.
+    const Hierarchy* tracer = nullptr;
+    /// Only the rays are wanted: tests that decide a hit count but no ray (whether a shadow or
+    /// ambient-occlusion segment is occluded, what a diffuse ray meets) are skipped, and those
+    /// kinds' hit counts are left out of the summary. What a ray sample needs.
+    bool rays_only = false;
 };
 
 /// A registered ray distribution (`--rays NAME`): its name, what it is, and how it is made.

@@ -34,6 +34,9 @@ struct WhittedOptions {
     int width = 513, height = 513;
     int max_depth = 5;   ///< the eye ray is depth 1
     bool record = true;  ///< keep the rays; false gives the counts alone
+    /// Test the shadow rays; false records them untested (no hits counted, no light in the
+    /// colour): the same rays, for when only the rays are wanted.
+    bool shadow_tests = true;
     int threads = 0;     ///< 0: all cores
     /// Called now and then with eye-ray rows done of `height` (serialised).
     std::function<void(std::size_t)> progress;
@@ -58,20 +61,23 @@ enum class CameraHitRays {
     AO,       ///< one cosine-weighted segment of length ao_length()
 };
 /// `seed` drives the random directions (per pixel, so independent of threads). The camera rays
-/// themselves are counted in `counts` (kind Eye) but are not in `rays`.
+/// themselves are counted in `counts` (kind Eye) but are not in `rays`. With `test_spawned`
+/// false the spawned rays are recorded without being traced (no hits counted for them).
 RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int height, std::uint64_t seed,
-                        int threads = 0, const std::function<void(std::size_t)>& progress = {});
+                        int threads = 0, const std::function<void(std::size_t)>& progress = {},
+                        bool test_spawned = true);
 
 /// Length of ambient-occlusion segments: 5% of the scene box's diagonal.
 float ao_length(const Scene& scene);
 /// How far secondary rays start off the surface: 1e-5 of the scene box's diagonal.
 float spawn_offset(const Scene& scene);
 
-/// The ray sets `spd`, `shadow`, `diffuse` and `ao` of make_rays, traced through an internal
-/// bvh-sah. spd's default size is 512 (513 x 513 eye rays); the others default to the scene's
-/// resolution. `progress` gets eye-ray rows done. Throws InputError for another name.
-RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, int threads = 0,
-                      const std::function<void(std::size_t rows_done, std::size_t rows)>& progress = {});
+/// The ray sets `spd`, `shadow`, `diffuse` and `ao` of make_rays, traced through
+/// `making.tracer` (null: an internal bvh-sah). spd's default size is 512 (513 x 513 eye rays);
+/// the others default to the scene's resolution. `making.progress` gets eye-ray rows done; with
+/// `making.rays_only` the tests that decide no ray are skipped (RayMaking). Throws InputError
+/// for another name.
+RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, const RayMaking& making = {});
 /// True for the names make_tree_rays takes.
 bool is_tree_distribution(const std::string& name);
 

@@ -33,8 +33,8 @@ float spawn_offset(const Scene& scene) {
 
 namespace detail {
 
-WhittedTracer::WhittedTracer(const Hierarchy& h, int max_depth)
-    : scene_(h.scene()), h_(h), max_depth_(max_depth), eps_(spawn_offset(h.scene())),
+WhittedTracer::WhittedTracer(const Hierarchy& h, int max_depth, bool shadow_tests)
+    : scene_(h.scene()), h_(h), max_depth_(max_depth), shadow_tests_(shadow_tests), eps_(spawn_offset(h.scene())),
       light_scale_(h.scene().lights.empty() ? 1.0f : 1.0f / std::sqrt(static_cast<float>(h.scene().lights.size()))) {}
 
 bool WhittedTracer::surface(const Ray& ray, Hit& hit, Surface& s) const {
@@ -64,6 +64,11 @@ Vec3 WhittedTracer::trace(const Ray& ray, RayKind kind, int depth, Recorder* rec
         Vec3 to_light = light.position - o;
         if (!(dot(s.n, to_light) > 0)) continue;
         Ray shadow{o, to_light, 0, 1};
+        if (!shadow_tests_) {
+            // Only the rays are wanted: whether this one is blocked spawns nothing.
+            if (rec) rec->add(shadow, RayKind::Shadow, false);
+            continue;
+        }
         Hit sh;
         bool blocked = h_.any(shadow, sh);
         if (rec) rec->add(shadow, RayKind::Shadow, blocked);
@@ -170,7 +175,7 @@ using detail::cosine_direction;
 RayTree whitted_tree(const Hierarchy& h, const WhittedOptions& opt) {
     const Scene& scene = h.scene();
     const std::vector<Ray> eye = camera_rays(scene.camera, opt.width, opt.height);
-    detail::WhittedTracer tracer(h, opt.max_depth);
+    detail::WhittedTracer tracer(h, opt.max_depth, opt.shadow_tests);
     std::vector<Recorder> rows(static_cast<std::size_t>(opt.height));
     detail::run_rows(
         opt.height, opt.threads,
@@ -185,7 +190,7 @@ RayTree whitted_tree(const Hierarchy& h, const WhittedOptions& opt) {
 }
 
 RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int height, std::uint64_t seed,
-                        int threads, const std::function<void(std::size_t)>& progress) {
+                        int threads, const std::function<void(std::size_t)>& progress, bool test_spawned) {
     const Scene& scene = h.scene();
     const std::vector<Ray> eye = camera_rays(scene.camera, width, height);
     detail::WhittedTracer tracer(h, 1);
@@ -210,7 +215,7 @@ RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int 
                         if (!(dot(s.n, to_light) > 0)) continue;
                         Ray r{o, to_light, 0, 1};
                         Hit sh;
-                        rec.add(r, RayKind::Shadow, h.any(r, sh));
+                        rec.add(r, RayKind::Shadow, test_spawned && h.any(r, sh));
                     }
                     continue;
                 }
@@ -218,11 +223,11 @@ RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int 
                 Ray r{s.p + s.n * eps, cosine_direction(s.n, rng), 0, kInf};
                 Hit sh;
                 if (which == CameraHitRays::Diffuse) {
-                    h.closest(r, sh);
+                    if (test_spawned) h.closest(r, sh);
                     rec.add(r, RayKind::Diffuse, sh.hit());
                 } else {
                     r.tmax = ao;
-                    rec.add(r, RayKind::AO, h.any(r, sh));
+                    rec.add(r, RayKind::AO, test_spawned && h.any(r, sh));
                 }
             }
         },
@@ -234,17 +239,19 @@ bool is_tree_distribution(const std::string& name) {
     return name == "spd" || name == "shadow" || name == "diffuse" || name == "ao";
 }
 
-RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, int threads,
-                      const std::function<void(std::size_t, std::size_t)>& progress) {
+RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, const RayMaking& making) {
     if (!is_tree_distribution(spec.name)) throw InputError(spec.name, 0, "not a ray tree distribution");
     const bool spd = spec.name == "spd";
     int w = spd ? 512 : scene.camera.width, h = spd ? 512 : scene.camera.height;
     if (!spec.size.empty()) parse_size(spec.size, "--size", w, h);
     // Hits are exact, so the rays are the same whichever hierarchy finds them: use a fast one.
-    auto bvh = build_hierarchy(scene, "bvh-sah");
+    std::unique_ptr<Hierarchy> own;
+    if (!making.tracer) own = build_hierarchy(scene, "bvh-sah");
+    const Hierarchy& bvh = making.tracer ? *making.tracer : *own;
+    const int threads = making.threads;
     const int rows = spd ? h + 1 : h;
     std::function<void(std::size_t)> rows_done;
-    if (progress) rows_done = [&](std::size_t d) { progress(d, static_cast<std::size_t>(rows)); };
+    if (making.progress) rows_done = [&](std::size_t d) { making.progress(d, static_cast<std::size_t>(rows)); };
 
     RayTree tree;
     std::string described;
@@ -254,13 +261,14 @@ RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, int threads,
         opt.height = h + 1;
         opt.threads = threads;
         opt.progress = rows_done;
-        tree = whitted_tree(*bvh, opt);
+        opt.shadow_tests = !making.rays_only;
+        tree = whitted_tree(bvh, opt);
         described = fmt::format("spd {}x{} ({}x{} corner eye rays, depth 5)", w, h, w + 1, h + 1);
     } else {
         CameraHitRays which = spec.name == "shadow"    ? CameraHitRays::Shadow
                               : spec.name == "diffuse" ? CameraHitRays::Diffuse
                                                        : CameraHitRays::AO;
-        tree = camera_hit_rays(*bvh, which, w, h, spec.seed, threads, rows_done);
+        tree = camera_hit_rays(bvh, which, w, h, spec.seed, threads, rows_done, !making.rays_only);
         described = which == CameraHitRays::Shadow ? fmt::format("shadow rays of camera {}x{} hits", w, h)
                                                    : fmt::format("{} rays of camera {}x{} hits seed {}", spec.name, w, h,
                                                                  spec.seed);
@@ -277,14 +285,17 @@ RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, int threads,
         // Camera rays only seed the other sets and are not in them: say so by the name.
         std::string name(!spd && kind == RayKind::Eye ? "camera" : ray_kind_name(kind));
         set.summary.push_back({name, tree.counts.rays[k]});
-        set.summary.push_back({name + "_hits", tree.counts.hits[k]});
+        // Rays made without their tests have no hit count.
+        const bool tested = !making.rays_only || kind == RayKind::Eye || kind == RayKind::Reflection ||
+                            kind == RayKind::Refraction;
+        if (tested) set.summary.push_back({name + "_hits", tree.counts.hits[k]});
     }
     return set;
 }
 
 namespace {
 RaySet make_tree(const Scene& scene, const RaySpec& spec, const RayMaking& making) {
-    return make_tree_rays(scene, spec, making.threads, making.progress);
+    return make_tree_rays(scene, spec, making);
 }
 const RayDistributionRegistration kSpd{
     {.name = "spd",

@@ -38,7 +38,8 @@ struct Surface {
 
 class WhittedTracer {
 public:
-    WhittedTracer(const Hierarchy& h, int max_depth);
+    /// `shadow_tests` false: shadow rays are recorded untested (WhittedOptions::shadow_tests).
+    WhittedTracer(const Hierarchy& h, int max_depth, bool shadow_tests = true);
     /// Colour seen along `ray` of depth `depth` (eye ray: 1); records every ray spawned in `rec`.
     Vec3 trace(const Ray& ray, RayKind kind, int depth, Recorder* rec) const;
     /// Fills `s` for a hit of `ray` (completing `hit`'s normal); false on a miss.
@@ -49,6 +50,7 @@ private:
     const Scene& scene_;
     const Hierarchy& h_;
     int max_depth_;
+    bool shadow_tests_;
     float eps_;
     float light_scale_;
 };
