@@ -34,6 +34,9 @@ struct DesignInput {
     RaySpec spec;               ///< the distribution the sample was drawn from
     std::size_t count = 4096;   ///< requested sample size
     std::uint64_t seed = 1;     ///< the draw's seed
+    /// The bvh-sah (default parameters) that made the rays and found the sample's ends: a
+    /// design that compares with bvh-sah's tree takes it rather than building it again.
+    std::shared_ptr<const Hierarchy> reference;
 };
 
 /// Reads the design parameters from `p` and draws the sample: `sample` rays of the distribution

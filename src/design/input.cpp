@@ -38,6 +38,7 @@ DesignInput draw_design_input(const Scene& scene, const Params& p) {
     const std::size_t n = std::min(in.count, all.rays.size() / 2);
     if (n == 0) throw InputError("--set", 0, "rays=" + in.spec.name + ": too few rays to draw a design sample from");
     in.sample = draw_sample_from(scene, all, n, in.seed, *reference);
+    in.reference = std::move(reference);
     return in;
 }
 

@@ -254,7 +254,11 @@ const Registration reg{
          usual.max_depth = o.max_depth;
          usual.bins = o.bins;
          auto designed = std::make_unique<Bvh>(s, "bvh-design", d.data, true);
-         auto by_sah = std::make_unique<Bvh>(s, "bvh-design", build_sah(s, usual), true);
+         // With bvh-sah's defaults that tree is the sample's reference, already built.
+         const SahOptions sah_defaults;
+         const auto* reference = dynamic_cast<const Bvh*>(in.reference.get());
+         const bool as_reference = reference && usual.max_depth == sah_defaults.max_depth && usual.bins == sah_defaults.bins;
+         auto by_sah = std::make_unique<Bvh>(s, "bvh-design", as_reference ? reference->data() : build_sah(s, usual), true);
          if (!p.is("occlusion", "sample")) {
              // Each tree in the order asked for, or in the order the model predicts cheaper on
              // the sample (only its occlusion rays can tell the two apart).
