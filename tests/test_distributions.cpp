@@ -1,21 +1,23 @@
 // Every registered ray distribution, read from the registry (a new one is tested here without
 // touching this file): it makes rays of its kinds, deterministically for a seed, and says what
-// it made; `make_rays` names them all when asked for one that does not exist.
+// it made; `make_rays` names them all when asked for one that does not exist; made for a ray
+// sample (another tracer, the rays alone) it makes the same rays.
 #include <set>
 
+#include "rtcost/hierarchy.hpp"
 #include "rtcost/rays.hpp"
 #include "test_support.hpp"
 
 namespace rtcost::test {
 namespace {
 
-RaySet make(const Scene& s, const std::string& name, std::uint64_t seed) {
+RaySet make(const Scene& s, const std::string& name, std::uint64_t seed, const RayMaking& making = {}) {
     RaySpec spec;
     spec.name = name;
     spec.size = "12x10";
     spec.count = 300;
     spec.seed = seed;
-    return make_rays(s, spec);
+    return make_rays(s, spec, making);
 }
 
 bool same_rays(const RaySet& a, const RaySet& b) {
@@ -66,6 +68,22 @@ TEST(RayDistributions, EveryRegisteredOneMakesDeterministicRaysOfItsKinds) {
         ADD_FAILURE() << "no error";
     } catch (const InputError& e) {
         for (const std::string& n : in_order) EXPECT_NE(std::string(e.what()).find(n), std::string::npos) << n;
+    }
+}
+
+// What a design sample asks for: the rays traced through a given hierarchy, without the tests
+// that decide no ray. The rays must be the very same (the sample is drawn by index).
+TEST(RayDistributions, RaysAloneThroughAnyTracerAreTheSameRays) {
+    const Scene s = builtin_scene("balls", 1);
+    auto brute = build_hierarchy(s, "brute");
+    RayMaking alone;
+    alone.tracer = brute.get();
+    alone.rays_only = true;
+    for (const RayDistributionInfo* d : ray_distributions()) {
+        SCOPED_TRACE(d->name);
+        const RaySet full = make(s, d->name, 3), rays = make(s, d->name, 3, alone);
+        EXPECT_TRUE(same_rays(full, rays));
+        EXPECT_EQ(rays.described, full.described);
     }
 }
 
