@@ -14,44 +14,12 @@ PrimInfo::PrimInfo(const Scene& s) : bounds(s.size()), centroids(s.size()) {
 
 Bvh::Bvh(const Scene& s, std::string name, BvhData data, bool ordered)
     : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered), prims_(leaf_prims(s, d_.refs)),
-      pairs_(child_pairs(d_)) {}
-
-std::vector<ChildPair> child_pairs(const BvhData& d) {
-    std::vector<ChildPair> pairs;
-    if (d.nodes.empty() || d.nodes[0].leaf) return pairs;
-    std::size_t interior = 0;
-    for (const Node& n : d.nodes) {
-        if (n.leaf) continue;
-        if (n.count != 2) return {};
-        ++interior;
-    }
-    pairs.reserve(interior);
-    // Depth first: a first child's record follows its parent's, in the same or the next line.
-    auto fill = [&](auto&& self, const Node& n) -> void {
-        const std::size_t at = pairs.size();
-        pairs.emplace_back();
-        for (int k = 0; k < 2; ++k) {
-            const Node& c = d.nodes[n.index + k];
-            pairs[at].x[k] = c.box.lo.x, pairs[at].x[k + 2] = c.box.hi.x;
-            pairs[at].y[k] = c.box.lo.y, pairs[at].y[k + 2] = c.box.hi.y;
-            pairs[at].z[k] = c.box.lo.z, pairs[at].z[k + 2] = c.box.hi.z;
-            if (c.leaf) {
-                pairs[at].child[k] = ChildRef{c.index, c.count, 1};
-            } else {
-                pairs[at].child[k] = ChildRef{static_cast<std::uint32_t>(pairs.size()), 2, 0};
-                self(self, c);
-            }
-        }
-    };
-    fill(fill, d.nodes[0]);
-    return pairs;
-}
+      has_triangles_(std::any_of(prims_.begin(), prims_.end(), [](const LeafPrim& p) { return p.as_triangle; })) {}
 
 StructureStats Bvh::compute_structure() const {
     StructureStats s = tree_structure(
         d_.nodes, [](const Node& n) { return n.leaf != 0; }, [](const Node& n) { return std::uint32_t(n.count); });
-    s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + prims_.size() * sizeof(LeafPrim) +
-              pairs_.size() * sizeof(ChildPair);
+    s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + prims_.size() * sizeof(LeafPrim);
     s.limits = d_.limits;
     return s;
 }

@@ -9,7 +9,6 @@
 
 #include "../common/impl.hpp"
 #include "../common/leaf_prims.hpp"
-#include "child_pairs.hpp"
 
 namespace rtcost::bvh {
 
@@ -32,10 +31,6 @@ struct BvhData {
     std::vector<std::uint32_t> refs;   ///< primitive ids in leaf order
     std::vector<std::string> limits;   ///< bounds that stopped the build, for StructureStats::limits
 };
-
-/// The traversal records of a binary tree (pairs[0] holds the root's children), or nothing when
-/// some node is not binary or the root is a leaf (the generic walk then reads the nodes).
-std::vector<ChildPair> child_pairs(const BvhData& d);
 
 /// Per-primitive bounds and centroids, computed once per build.
 struct PrimInfo {
@@ -81,10 +76,6 @@ public:
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
         // Query::All never cuts by a hit found, which is the unordered walk.
-        if (!pairs_.empty()) {
-            if constexpr (Q == Query::All) return walk_pairs<C, Q, false>(ray, hit, counting);
-            else return ordered_ ? walk_pairs<C, Q, true>(ray, hit, counting) : walk_pairs<C, Q, false>(ray, hit, counting);
-        }
         if constexpr (Q == Query::All) return walk<C, Q, false>(ray, hit, counting);
         else return ordered_ ? walk<C, Q, true>(ray, hit, counting) : walk<C, Q, false>(ray, hit, counting);
     }
@@ -105,7 +96,8 @@ private:
         int sp = 0;
         const Node* nodes = d_.nodes.data();
         const RayInv ri(ray);
-        const RayShear shear(ray.d);
+        // Three divisions a ray pays only where there are triangles to test (not in a scene of spheres).
+        const RayShear shear = has_triangles_ ? RayShear(ray.d) : RayShear();
         counting.box();
         float t0 = box_entry(nodes[0].box, ri, ray.tmin, ray.tmax);
         if (t0 == kInf) return false;
@@ -188,68 +180,6 @@ private:
         return found;
     }
 
-    /// `walk` for a binary tree, over its ChildPairs: the same visits in the same order, the same
-    /// counts, each interior visit one cache line and one two-box test.
-    template <class C, Query Q, bool kOrdered>
-    bool walk_pairs(const Ray& ray, Hit& hit, C& counting) const {
-        struct Entry {
-            ChildRef ref;
-            float t;
-            int depth;
-        };
-        Entry stack[kMaxDepth * (kMaxFanout - 1) + 2];  // as walk's (one sibling waits per level)
-        int sp = 0;
-        const ChildPair* pairs = pairs_.data();
-        const RayInv ri(ray);
-        const PairRay pr(ri);
-        const RayShear shear(ray.d);
-        counting.box();
-        const float t0 = box_entry(d_.nodes[0].box, ri, ray.tmin, ray.tmax);
-        if (t0 == kInf) return false;
-        bool found = false;
-        Entry e{ChildRef{0, 2, 0}, t0, 0};
-        for (;;) {
-            {
-                if constexpr (kOrdered) {
-                    if (e.t >= hit.t) goto pop;  // the whole box lies beyond the current hit
-                }
-                if (e.ref.leaf) {
-                    counting.leaf(e.depth, e.ref.count);
-                    if (test_leaf<C, Q>(e.ref.index, e.ref.count, ray, shear, hit, counting, found)) return true;
-                    goto pop;
-                }
-                counting.interior(e.depth);
-                const float limit = kOrdered ? std::min(hit.t, ray.tmax) : ray.tmax;
-                const ChildPair& n = pairs[e.ref.index];
-                counting.box();
-                counting.box();
-                float ta, tb;
-                pair_entry(n, pr, ray.tmin, limit, ta, tb);
-                Entry a{n.child[0], ta, e.depth + 1}, b{n.child[1], tb, e.depth + 1};
-                if constexpr (kOrdered) {
-                    if (second_first<Q>(a.ref.leaf, b.ref.leaf, ta, tb)) std::swap(a, b);
-                }
-                if (a.t != kInf) {
-                    if (b.t != kInf) {
-                        stack[sp++] = b;
-                        if (b.ref.leaf) __builtin_prefetch(prims_.data() + b.ref.index);
-                        else __builtin_prefetch(pairs + b.ref.index);
-                    }
-                    e = a;
-                    continue;
-                }
-                if (b.t != kInf) {
-                    e = b;
-                    continue;
-                }
-            }
-        pop:
-            if (sp == 0) break;
-            e = stack[--sp];
-        }
-        return found;
-    }
-
     /// Tests the leaf's `count` primitives from prims_[first]; true when an any-hit query ends.
     template <class C, Query Q>
     bool test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, const RayShear& shear, Hit& hit, C& counting,
@@ -283,7 +213,7 @@ private:
     bool ordered_;
     bool any_leaves_first_ = false;
     std::vector<LeafPrim> prims_;  ///< BvhData::refs as their tests need them, in leaf order
-    std::vector<ChildPair> pairs_;  ///< the traversal's records of a binary tree (child_pairs)
+    bool has_triangles_ = false;    ///< some LeafPrim is tested as a triangle (RayShear needed)
 };
 
 }  // namespace rtcost::bvh
