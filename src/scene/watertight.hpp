@@ -15,8 +15,10 @@ namespace rtcost {
 /// The ray's part of the watertight test: its largest direction component becomes z, and the
 /// shear that makes the ray the +z axis.
 struct RayShear {
-    int kx, ky, kz;
-    float sx, sy, sz;
+    int kx = 0, ky = 1, kz = 2;
+    float sx = 0, sy = 0, sz = 0;
+    /// Unset: for a traversal of a scene without triangles, which never asks for it.
+    RayShear() = default;
     explicit RayShear(const Vec3& d) : kz(max_axis(d)) {
         kx = (kz + 1) % 3;
         ky = (kx + 1) % 3;
