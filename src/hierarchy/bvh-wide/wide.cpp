@@ -146,14 +146,7 @@ void append_packs(std::vector<BvhWide::Data::Block>& arena, const Scene& s, cons
     count = static_cast<std::uint32_t>(tris.size()) | static_cast<std::uint32_t>(others.size()) << 16;
 }
 
-/// The pack width of a leaf of `ntri` triangles in a tree of `K`-lane packs: a leaf of at most
-/// four is one pack of four (eight lanes would be mostly empty and twice the bytes to read).
-template <int K>
-constexpr int pack_lanes(std::uint32_t ntri) {
-    return K > 4 && ntri <= 4 ? 4 : K;
-}
-
-/// Appends the leaf over `ids` to the arena: its triangles in packs (pack_lanes), then its
+/// Appends the leaf over `ids` to the arena: its triangles in packs (pack_lanes, wide.hpp), then its
 /// other primitives.
 template <int K>
 void append_leaf(std::vector<BvhWide::Data::Block>& arena, const Scene& s, std::span<const std::uint32_t> ids,
@@ -165,7 +158,7 @@ void append_leaf(std::vector<BvhWide::Data::Block>& arena, const Scene& s, std::
     for (std::uint32_t id : ids) (pack_triangle(s, id, t) ? tris : others).push_back(id);
     if (tris.size() > 0xffff || others.size() > 0xffff)
         throw InputError("bvh-wide", 0, "a leaf of more than 65535 primitives of one kind");
-    if (pack_lanes<K>(static_cast<std::uint32_t>(tris.size())) == 4) append_packs<4>(arena, s, tris, others, child, count);
+    if (pack_lanes(K, static_cast<std::uint32_t>(tris.size())) == 4) append_packs<4>(arena, s, tris, others, child, count);
     else append_packs<K>(arena, s, tris, others, child, count);
 }
 
@@ -184,7 +177,7 @@ std::vector<std::uint32_t> leaf_ids(const BvhWide::Data& d, std::uint32_t child,
     std::vector<std::uint32_t> ids;
     const std::uint32_t ntri = count & 0xffffu, nother = count >> 16;
     const auto* at = reinterpret_cast<const std::byte*>(d.leaves.data() + (child & ~kLeaf));
-    if (pack_lanes<K>(ntri) == 4) read_leaf<4>(at, ntri, nother, ids);
+    if (pack_lanes(K, ntri) == 4) read_leaf<4>(at, ntri, nother, ids);
     else read_leaf<K>(at, ntri, nother, ids);
     return ids;
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "../common/impl.hpp"
+#include "scene/watertight.hpp"
 
 namespace rtcost::wide {
 
@@ -50,6 +51,11 @@ struct alignas(32) TriPack {
     PrimKind kind[K];
 };
 
+/// The pack width of a leaf of `ntri` triangles in a tree of `tri_lanes`-lane packs: a leaf of
+/// at most four is one pack of four (eight lanes would be mostly empty and twice the bytes to
+/// read). The builder stores and the traversals read leaves by it.
+constexpr int pack_lanes(int tri_lanes, std::uint32_t ntri) { return tri_lanes > 4 && ntri <= 4 ? 4 : tri_lanes; }
+
 /// A leaf's storage begins at a multiple of this many bytes in the leaf arena.
 inline constexpr std::size_t kLeafAlign = 32;
 
@@ -57,8 +63,7 @@ inline constexpr std::size_t kLeafAlign = 32;
 /// `child` is kLeaf | (its offset in `leaves` / kLeafAlign) and its `count` packs the
 /// triangles (low 16 bits) and the other primitives (high 16 bits). At that offset lie
 /// ceil(triangles / K) TriPack<K>, then the other primitives as Other records, where K is
-/// tri_lanes, but 4 for a leaf of at most four triangles (a pack of eight would be mostly empty
-/// lanes, and twice the bytes to read).
+/// pack_lanes(tri_lanes, triangles).
 struct View {
     const void* nodes = nullptr;
     int width = 8;
