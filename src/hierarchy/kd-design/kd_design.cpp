@@ -57,7 +57,7 @@ const Registration reg{
          const SahOptions usual_sah;  // kd-sah's defaults
          std::vector<float> bonuses = {usual_sah.empty_bonus, 0.0f};
          if (!p.is("empty_bonus", "auto")) bonuses = {static_cast<float>(p.real("empty_bonus"))};
-         std::unique_ptr<Hierarchy> best;
+         std::vector<std::unique_ptr<Hierarchy>> trees;  // a tie keeps the earlier: kd-sah's bonus first
          for (float bonus : bonuses) {
              // An interior visit of kd-sah's traversal: a step and one plane.
              Designer d{{}, designing::CellRays(s, in, p.real("trust"), in.costs.step + in.costs.plane)};
@@ -66,15 +66,13 @@ const Registration reg{
              const Chooser choose = [&d](const std::vector<BuildRef>& refs, const Box3& cell, int) {
                  return d.choose(refs, cell);
              };
-             auto designed = std::make_unique<KdTree>(s, "kd-design", build_tree(s, d.sah.build, choose), p.flag("mailbox"));
-             // A tie keeps the earlier tree: kd-sah's bonus first.
-             best = best ? designing::cheaper_on_sample(std::move(best), std::move(designed), s, in) : std::move(designed);
+             trees.push_back(std::make_unique<KdTree>(s, "kd-design", build_tree(s, d.sah.build, choose), p.flag("mailbox")));
          }
          SahOptions usual = usual_sah;  // kd-sah's defaults, with this tree's depth and assignment
          usual.build = build;
          usual.build.max_prims = 1;
-         auto by_sah = std::make_unique<KdTree>(s, "kd-design", build_sah(s, usual), p.flag("mailbox"));
-         return designing::cheaper_on_sample(std::move(best), std::move(by_sah), s, in);
+         trees.push_back(std::make_unique<KdTree>(s, "kd-design", build_sah(s, usual), p.flag("mailbox")));
+         return designing::cheapest_on_sample(std::move(trees), s, in);
      },
      kLargeScene}};  // kd-sah's O(N log^2 N) planes, each judged on the sample: 19 s for a million triangles
 
