@@ -23,8 +23,12 @@ int cmd_sample(SampleArgs& a, const Common& common) {
     if (a.count == 0) throw InputError("--count", 0, "a sample needs at least one ray");
     // Any exact hierarchy finds the same ends; the SAH BVH is quick to build and to trace.
     auto reference = build(scene, BuildArgs{a.scene, "bvh-sah", {}}, common);
-    const RaySample s = draw_sample(scene, a.rays, a.count, a.rays.seed, *reference, parse_query(a.query),
-                                    parse_query(a.shadow));
+    // The whole distribution, so that the file says how many rays it was drawn from (eval
+    // checks that its test rays are that distribution).
+    RayMaking making;
+    making.tracer = reference.get();
+    const RaySample s = draw_sample_from(scene, make_rays(scene, a.rays, making), a.count, a.rays.seed, *reference,
+                                         parse_query(a.query), parse_query(a.shadow));
     write_sample(a.out, s);
     std::array<std::size_t, kRayKinds> rays{}, ended{};
     for (std::size_t i = 0; i < s.size(); ++i) {

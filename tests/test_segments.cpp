@@ -291,7 +291,9 @@ TEST(ModelSegments, EvaluatePredictsHeldOutCameraRays) {
     spec.size = "160x160";
     const EvalResult r = evaluate(s, spec, opt);
     EXPECT_EQ(r.sample_rays, 2000u);
-    EXPECT_EQ(r.test_rays, 160u * 160u - 2000u);
+    // One camera ray a pixel: the draw took the pixels of twice the sample's rays, and the test
+    // rays are every other pixel's.
+    EXPECT_EQ(r.test_rays, 160u * 160u - 2u * 2000u);
     EXPECT_EQ(r.distribution_rays, 160u * 160u);  // what a prediction's time is weighed against
     EXPECT_EQ(r.split, "sample");
     ASSERT_EQ(r.rows.size(), 4u);

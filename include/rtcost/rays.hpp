@@ -58,6 +58,12 @@ struct RaySet {
     std::vector<std::pair<std::string, std::size_t>> summary;
     /// Problems worth telling the user that do not make the set invalid (rays too far away).
     std::vector<std::string> warnings;
+    /// Camera-based distributions: the pixels of the image their eye rays go through (a ray
+    /// tree's corners for spd), and per ray the pixel whose eye ray it descends from, in
+    /// ascending order (a ray sample is drawn by pixel: sample.hpp). 0 and empty otherwise.
+    std::size_t image_pixels = 0;
+    std::size_t image_width = 0;  ///< pixels a row (pixel index = row x width + column)
+    std::vector<std::uint32_t> pixels;
 };
 
 /// How far from a scene, in units of its size (the largest side of its bounds), a ray may start
@@ -107,6 +113,10 @@ struct RayMaking {
     /// ambient-occlusion segment is occluded, what a diffuse ray meets) are skipped, and those
     /// kinds' hit counts are left out of the summary. What a ray sample needs.
     bool rays_only = false;
+    /// Camera-based distributions: only the rays of these pixels (ascending, each below the
+    /// image's pixel count; an empty list makes no rays but says `image_pixels`). Null: every
+    /// pixel. Each pixel's rays are the same as in the whole set. Others ignore it.
+    const std::vector<std::uint32_t>* only_pixels = nullptr;
 };
 
 /// A registered ray distribution (`--rays NAME`): its name, what it is, and how it is made.
@@ -146,6 +156,10 @@ RaySet make_rays(const Scene& scene, const RaySpec& spec, const RayMaking& makin
 
 /// Most rays one ray set may hold (--count, --size W*H): about 60 bytes each with the hits.
 inline constexpr std::uint64_t kMaxRays = 50'000'000;
+
+/// Throws std::invalid_argument unless `only` (RayMaking::only_pixels) is null or ascending
+/// distinct pixel indices below `image_pixels` (for distributions' makers).
+void check_pixel_subset(const std::vector<std::uint32_t>* only, std::size_t image_pixels);
 
 /// Parses "WxH" (e.g. "512x512") with W*H <= kMaxRays; throws InputError naming `what` otherwise.
 void parse_size(const std::string& text, const std::string& what, int& width, int& height);

@@ -45,17 +45,30 @@ struct RaySample {
 /// first, and the hits a BVH finds in subtrees it visits before the nearest one.
 inline constexpr std::size_t kMaxCrossings = 16;
 
-/// Draws `count` rays of the distribution `spec` names, without replacement and stratified
-/// along the distribution's order (one ray from each of `count` equal runs: every kind of a ray
-/// tree in its proportion, camera-based kinds spread evenly over the image), and finds how
-/// each one ends with `reference` (any exact hierarchy over the same scene). Shadow and
+/// Draws `count` rays of the distribution `spec` names, without replacement, and finds how each
+/// one ends with `reference` (any exact hierarchy over the same scene). Shadow and
 /// ambient-occlusion rays get `occlusion`, the others `query`. Deterministic for a seed.
+///  - A camera-based distribution (RaySet::image_pixels) is drawn by pixel: the sample's pixels
+///    are a prefix of a seeded low-discrepancy order of the image's pixels (spread evenly over
+///    the image), long enough to hold twice `count` rays and at most half the pixels, and the
+///    sample is `count` of their rays stratified along the distribution's order (every kind of
+///    a ray tree in its proportion). Only those pixels are traced, with `reference`: about
+///    twice the sample's rays, whatever the distribution's size. `population` is then 0 (the
+///    whole distribution is never made).
+///  - Any other is made whole and `count` rays (at most half of them) are drawn stratified
+///    along its order: one from each of `count` equal runs.
 RaySample draw_sample(const Scene& scene, const RaySpec& spec, std::size_t count, std::uint64_t seed,
                       const Hierarchy& reference, Query query = Query::Closest, Query occlusion = Query::Any);
 
-/// The same from the whole distribution's rays, already made.
+/// The same from the whole distribution's rays, already made: for a camera-based one the same
+/// sample as draw_sample's, for another `count` rays (not capped) stratified along its order.
+/// `population` is `all`'s size.
 RaySample draw_sample_from(const Scene& scene, const RaySet& all, std::size_t count, std::uint64_t seed,
                            const Hierarchy& reference, Query query = Query::Closest, Query occlusion = Query::Any);
+
+/// How many rays draw_sample_from(all, count, seed) draws: `count`, or fewer where `all` has
+/// too few (a camera-based distribution's half of the pixels may hold fewer).
+std::size_t sample_size(const RaySet& all, std::size_t count, std::uint64_t seed);
 
 /// Finds how each of `s`'s rays ends (t_end and crossings, replacing any) with `reference`, an
 /// exact hierarchy over the scene, tracing with the rays' own tmin and tmax.
@@ -74,7 +87,9 @@ RaySample draw_visibility_sample(const Scene& scene, std::span<const RayKind> ki
                                  Query occlusion = Query::Any);
 
 /// The rays of `all` that are not in the sample drawn from it with the same count and seed (the
-/// test rays disjoint from a sample), in their order.
+/// test rays disjoint from a sample), in their order. For a camera-based distribution, the rays
+/// of every pixel the sample's draw took are left out (sampled or not): the test rays are those
+/// of the pixels the draw never traced.
 RaySet rays_outside_sample(const RaySet& all, std::size_t count, std::uint64_t seed);
 
 /// Sample file: "RTCSAMPL" then version, counts and the records (little-endian; the README

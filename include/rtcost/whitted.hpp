@@ -38,6 +38,9 @@ struct WhittedOptions {
     /// colour): the same rays, for when only the rays are wanted.
     bool shadow_tests = true;
     int threads = 0;     ///< 0: all cores
+    /// Only the ray trees of these pixels (ascending indices into the width x height grid of
+    /// eye rays); null: all.
+    const std::vector<std::uint32_t>* pixels = nullptr;
     /// Called now and then with eye-ray rows done of `height` (serialised).
     std::function<void(std::size_t)> progress;
 };
@@ -47,6 +50,7 @@ struct WhittedOptions {
 struct RayTree {
     std::vector<Ray> rays;
     std::vector<RayKind> kinds;
+    std::vector<std::uint32_t> pixels;  ///< per ray, the pixel of the eye ray it descends from
     KindCounts counts;
 };
 
@@ -65,7 +69,7 @@ enum class CameraHitRays {
 /// false the spawned rays are recorded without being traced (no hits counted for them).
 RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int height, std::uint64_t seed,
                         int threads = 0, const std::function<void(std::size_t)>& progress = {},
-                        bool test_spawned = true);
+                        bool test_spawned = true, const std::vector<std::uint32_t>* pixels = nullptr);
 
 /// Length of ambient-occlusion segments: 5% of the scene box's diagonal.
 float ao_length(const Scene& scene);

@@ -32,6 +32,14 @@ std::vector<std::string> design_set(const DesignOptions& opt, const Scene& scene
     return set;
 }
 
+// The size of the sample draw_design_input draws (draw_sample): as asked for a camera-based
+// distribution, at most half the rays of another; no more than the rays the draw can take.
+std::size_t design_sample_size(const Scene& scene, const RaySpec& rays, std::size_t count, std::uint64_t seed) {
+    const RaySet all = make_rays(scene, rays);
+    const std::size_t asked = all.image_pixels ? count : std::min(count, std::max<std::size_t>(all.rays.size() / 2, 1));
+    return sample_size(all, asked, seed);
+}
+
 }  // namespace
 
 std::vector<std::string> design_families() {
@@ -77,10 +85,9 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
         eo.interleave_timing = true;
         eo.sample_seed = opt.seed;
         eo.on_step = opt.on_step;
-        // The designed hierarchy caps its sample at half the rays; the evaluation leaves out the
-        // same draw, so the test rays are the ones the design never saw.
-        const std::size_t pop = make_rays(scene, opt.rays).rays.size();
-        eo.segments = std::min(opt.sample, pop / 2);
+        // The evaluation draws the designed hierarchy's sample again (draw_sample's) and leaves
+        // it out, so the test rays are the ones the design never saw.
+        eo.segments = design_sample_size(scene, opt.rays, opt.sample, opt.seed);
         const EvalResult r = evaluate(scene, opt.rays, eo);
         res.distribution = r.distribution;
         res.sample = r.sample_rays;

@@ -28,16 +28,10 @@ DesignInput draw_design_input(const Scene& scene, const Params& p) {
     in.count = static_cast<std::size_t>(p.integer("sample"));
     in.seed = static_cast<std::uint64_t>(p.integer("seed"));
     in.costs = UnitCosts::named(p.str("costs"));
-    // One bvh-sah both makes the distribution's rays (if it is made by tracing) and finds the
-    // sample's ends; only the rays are wanted, not which shadow rays are blocked.
+    // One bvh-sah both makes the sample's rays (if the distribution is made by tracing: only
+    // at the sample's pixels) and finds the sample's ends.
     auto reference = build_hierarchy(scene, "bvh-sah");
-    RayMaking making;
-    making.tracer = reference.get();
-    making.rays_only = true;
-    const RaySet all = make_rays(scene, in.spec, making);
-    const std::size_t n = std::min(in.count, all.rays.size() / 2);
-    if (n == 0) throw InputError("--set", 0, "rays=" + in.spec.name + ": too few rays to draw a design sample from");
-    in.sample = draw_sample_from(scene, all, n, in.seed, *reference);
+    in.sample = draw_sample(scene, in.spec, in.count, in.seed, *reference);
     in.reference = std::move(reference);
     return in;
 }

@@ -1,4 +1,6 @@
+#include <algorithm>
 #include <charconv>
+#include <stdexcept>
 #include <cmath>
 #include <numbers>
 
@@ -104,6 +106,14 @@ std::vector<Ray> random_rays(const Box3& box, std::size_t n, std::uint64_t seed)
     return rays;
 }
 
+void check_pixel_subset(const std::vector<std::uint32_t>* only, std::size_t image_pixels) {
+    if (!only) return;
+    if (!std::is_sorted(only->begin(), only->end()) ||
+        std::adjacent_find(only->begin(), only->end()) != only->end() ||
+        (!only->empty() && only->back() >= image_pixels))
+        throw std::invalid_argument("RayMaking::only_pixels: not ascending distinct pixels of the image");
+}
+
 void parse_size(const std::string& text, const std::string& what, int& width, int& height) {
     auto x = text.find('x');
     auto num = [&](std::string_view s, int& out) {
@@ -126,10 +136,28 @@ const RayDistributionRegistration kCamera{
      .description = "one eye ray per pixel centre of the scene's camera (--size WxH)",
      .order = 0,
      .benchmarked = true,
-     .make = [](const Scene& scene, const RaySpec& spec, const RayMaking&) {
+     .make = [](const Scene& scene, const RaySpec& spec, const RayMaking& making) {
          int w = scene.camera.width, h = scene.camera.height;
          if (!spec.size.empty()) parse_size(spec.size, "--size", w, h);
-         return one_kind(camera_rays(scene.camera, w, h), RayKind::Eye, fmt::format("camera {}x{}", w, h));
+         const std::size_t n = static_cast<std::size_t>(w) * h;
+         check_pixel_subset(making.only_pixels, n);
+         std::vector<Ray> rays = camera_rays(scene.camera, w, h);
+         std::vector<std::uint32_t> pixels;
+         if (making.only_pixels) {
+             pixels = *making.only_pixels;
+             std::vector<Ray> some;
+             some.reserve(pixels.size());
+             for (std::uint32_t p : pixels) some.push_back(rays[p]);
+             rays = std::move(some);
+         } else {
+             pixels.resize(n);
+             for (std::size_t i = 0; i < n; ++i) pixels[i] = static_cast<std::uint32_t>(i);
+         }
+         RaySet set = one_kind(std::move(rays), RayKind::Eye, fmt::format("camera {}x{}", w, h));
+         set.image_pixels = n;
+         set.image_width = static_cast<std::size_t>(w);
+         set.pixels = std::move(pixels);
+         return set;
      }}};
 const RayDistributionRegistration kLines{
     {.name = "lines",

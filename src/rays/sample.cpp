@@ -3,6 +3,9 @@
 #include "rtcost/sample.hpp"
 
 #include <algorithm>
+#include <bit>
+#include <cmath>
+#include <functional>
 #include <oneapi/tbb/parallel_for.h>
 
 #include "rtcost/error.hpp"
@@ -30,6 +33,146 @@ std::vector<std::size_t> pick(std::size_t n, std::size_t count, std::uint64_t se
     return idx;
 }
 
+/// The pixels of a width x height image in the order a sample takes them: a 2D low-discrepancy
+/// order. Pixel (x, y) has a code whose bits, most significant first, alternate between x's
+/// and y's (the longer side alone first, until both have as many left), and the order takes
+/// codes in bit-reversed counting order (the van der Corput sequence), Owen-scrambled with the
+/// seed (each bit flipped or not by a hash of the bits above it), skipping codes outside the
+/// image. Any prefix of 2^k codes then has one pixel in each of 2^k blocks that halve the image
+/// alternately across and down, at a random place in its block, so a few hundred pixels cover
+/// the image evenly in both directions without a regular pattern. (An order along the pixel
+/// index alone aligned with a width of a power of two and took whole columns.) A longer prefix
+/// keeps the shorter one's pixels: a sample can be traced pixel batch by pixel batch and be the
+/// same as one drawn from the whole distribution.
+class PixelOrder {
+public:
+    PixelOrder(std::size_t width, std::size_t height, std::uint64_t seed)
+        : width_(width), height_(height), seed_(mix64(seed ^ 0x5eed5a3b1e0f1ce5ull)) {
+        while ((std::uint64_t{1} << xbits_) < width) ++xbits_;
+        while ((std::uint64_t{1} << ybits_) < height) ++ybits_;
+        bits_ = xbits_ + ybits_;
+    }
+    /// The next pixel (row x width + column); false once every pixel was given.
+    bool next(std::uint32_t& pixel) {
+        while (i_ <= last()) {
+            const std::uint64_t code = scramble(bits_ ? reverse(i_) >> (64 - bits_) : 0);
+            ++i_;
+            std::uint64_t x = 0, y = 0;
+            int xb = xbits_, yb = ybits_;
+            for (int b = bits_ - 1; b >= 0; --b) {  // the code's bits, most significant first
+                const std::uint64_t bit = (code >> b) & 1;
+                // x takes a bit when it has more left than y, or as many (x first).
+                if (xb > 0 && (xb >= yb || yb == 0)) x |= bit << --xb;
+                else y |= bit << --yb;
+            }
+            if (x < width_ && y < height_) {
+                pixel = static_cast<std::uint32_t>(y * width_ + x);
+                return true;
+            }
+        }
+        return false;
+    }
+
+private:
+    std::uint64_t scramble(std::uint64_t code) const {
+        std::uint64_t out = 0, above = 1;  // the original bits above, after a leading 1
+        for (int b = bits_ - 1; b >= 0; --b) {
+            const std::uint64_t bit = (code >> b) & 1;
+            out |= (bit ^ (mix64(seed_ ^ (above * 0x9E3779B97F4A7C15ull)) & 1)) << b;
+            above = (above << 1) | bit;
+        }
+        return out;
+    }
+    std::uint64_t last() const { return bits_ >= 64 ? ~0ull : (std::uint64_t{1} << bits_) - 1; }
+    static std::uint64_t reverse(std::uint64_t x) {
+        x = ((x >> 1) & 0x5555555555555555ull) | ((x & 0x5555555555555555ull) << 1);
+        x = ((x >> 2) & 0x3333333333333333ull) | ((x & 0x3333333333333333ull) << 2);
+        x = ((x >> 4) & 0x0F0F0F0F0F0F0F0Full) | ((x & 0x0F0F0F0F0F0F0F0Full) << 4);
+        return __builtin_bswap64(x);  // std::byteswap is C++23
+    }
+    std::size_t width_, height_;
+    std::uint64_t seed_;
+    int xbits_ = 0, ybits_ = 0, bits_ = 0;
+    std::uint64_t i_ = 0;
+};
+
+/// A pixel-drawn sample takes the rays of about twice its size in pixels, so that it holds about
+/// every other ray of a pixel's ray tree rather than whole trees (a tree's rays are alike).
+constexpr std::size_t kPixelRaysPerSampleRay = 2;
+
+/// The pixels (ascending) whose rays a sample of `count` rays of a camera-based distribution is
+/// drawn from: a prefix of PixelOrder, as long as it takes to hold kPixelRaysPerSampleRay x
+/// `count` rays, and at most half the image (the other half stays for test rays).
+/// `rays_in(batch)` gives the number of rays of each pixel of a batch of the order's pixels:
+/// looked up in a whole distribution, or traced there and then.
+std::vector<std::uint32_t> sample_pixels(std::size_t image_pixels, std::size_t image_width, std::size_t count,
+                                         std::uint64_t seed,
+                                         const std::function<std::vector<std::size_t>(const std::vector<std::uint32_t>&)>& rays_in) {
+    if (image_width == 0 || image_pixels % image_width) throw std::logic_error("a ray set's image is not width x height");
+    PixelOrder order(image_width, image_pixels / image_width, seed);
+    const std::size_t cap = image_pixels / 2, want = kPixelRaysPerSampleRay * count;
+    std::vector<std::uint32_t> taken;
+    std::size_t rays = 0;
+    while (rays < want && taken.size() < cap) {
+        // A first batch of a sixteenth of the sample's pixels at one ray each, to learn how many
+        // rays a pixel holds (from none to dozens); then as many pixels as that says are
+        // missing, a quarter more, at least 64.
+        std::size_t size = std::max<std::size_t>(64, want / 16);
+        if (!taken.empty()) {
+            const double per_pixel = std::max(double(rays) / double(taken.size()), 1e-3);
+            const double missing = 1.25 * double(want - rays) / per_pixel;
+            size = std::max<std::size_t>(64, static_cast<std::size_t>(std::min(missing, 1e12)));
+        }
+        size = std::min(size, cap - taken.size());
+        std::vector<std::uint32_t> batch;
+        for (std::uint32_t p; batch.size() < size && order.next(p);) batch.push_back(p);
+        if (batch.empty()) break;
+        const std::vector<std::size_t> n = rays_in(batch);
+        for (std::size_t k = 0; k < batch.size() && rays < want; ++k) {
+            taken.push_back(batch[k]);
+            rays += n[k];
+        }
+    }
+    std::sort(taken.begin(), taken.end());
+    return taken;
+}
+
+/// The rays of `all` (a camera-based distribution: RaySet::pixels) of the sample's pixels.
+std::vector<std::size_t> rays_of_pixels(const RaySet& all, const std::vector<std::uint32_t>& taken) {
+    std::vector<std::size_t> out;
+    // Both ascending: one merge.
+    auto at = taken.begin();
+    for (std::size_t i = 0; i < all.pixels.size() && at != taken.end(); ++i) {
+        while (at != taken.end() && *at < all.pixels[i]) ++at;
+        if (at != taken.end() && *at == all.pixels[i]) out.push_back(i);
+    }
+    return out;
+}
+
+/// sample_pixels for a whole distribution.
+std::vector<std::uint32_t> sample_pixels(const RaySet& all, std::size_t count, std::uint64_t seed) {
+    if (all.pixels.size() != all.rays.size()) throw std::logic_error("a ray set without a pixel per ray");
+    return sample_pixels(all.image_pixels, all.image_width, count, seed, [&](const std::vector<std::uint32_t>& batch) {
+        std::vector<std::size_t> n(batch.size());
+        for (std::size_t k = 0; k < batch.size(); ++k) {
+            const auto [lo, hi] = std::equal_range(all.pixels.begin(), all.pixels.end(), batch[k]);
+            n[k] = static_cast<std::size_t>(hi - lo);
+        }
+        return n;
+    });
+}
+
+/// Indices into `all` of the sample of `count` (fewer where `all` has too few): stratified
+/// along the distribution's order, over all of it or, for a camera-based distribution, over the
+/// rays of the sample's pixels (sample_pixels).
+std::vector<std::size_t> sample_indices(const RaySet& all, std::size_t count, std::uint64_t seed) {
+    if (!all.image_pixels) return pick(all.rays.size(), count, seed);
+    const std::vector<std::size_t> from = rays_of_pixels(all, sample_pixels(all, count, seed));
+    std::vector<std::size_t> idx = pick(from.size(), count, seed);
+    for (std::size_t& i : idx) i = from[i];
+    return idx;
+}
+
 /// The first primitives `ray` meets, nearest first, each once (a closed surface is met again
 /// on its way out): closest-hit queries, each starting where the last hit was.
 std::vector<Crossing> crossings(const Hierarchy& h, const Ray& ray) {
@@ -51,10 +194,24 @@ std::vector<Crossing> crossings(const Hierarchy& h, const Ray& ray) {
 
 }  // namespace
 
+std::size_t sample_size(const RaySet& all, std::size_t count, std::uint64_t seed) {
+    return sample_indices(all, count, seed).size();
+}
+
 RaySet rays_outside_sample(const RaySet& all, std::size_t count, std::uint64_t seed) {
-    const std::vector<std::size_t> in = pick(all.rays.size(), count, seed);
+    // A camera-based distribution's sample leaves out every ray of its pixels, sampled or not:
+    // the test rays are those of the pixels it never traced.
+    std::vector<std::size_t> in;
+    if (all.image_pixels) {
+        if (all.pixels.size() != all.rays.size()) throw std::logic_error("a ray set without a pixel per ray");
+        in = rays_of_pixels(all, sample_pixels(all, count, seed));
+    } else {
+        in = pick(all.rays.size(), count, seed);
+    }
     RaySet out;
     out.described = all.described;
+    out.image_pixels = all.image_pixels;
+    out.image_width = all.image_width;
     out.rays.reserve(all.rays.size() - in.size());
     out.kinds.reserve(all.rays.size() - in.size());
     std::size_t next = 0;
@@ -65,6 +222,7 @@ RaySet rays_outside_sample(const RaySet& all, std::size_t count, std::uint64_t s
         }
         out.rays.push_back(all.rays[i]);
         out.kinds.push_back(all.kinds[i]);
+        if (all.image_pixels) out.pixels.push_back(all.pixels[i]);
     }
     return out;
 }
@@ -86,17 +244,11 @@ void find_ends(RaySample& s, const Hierarchy& reference) {
     s.first.push_back(static_cast<std::uint32_t>(s.crossings.size()));
 }
 
-RaySample draw_sample(const Scene& scene, const RaySpec& spec, std::size_t count, std::uint64_t seed,
-                      const Hierarchy& reference, Query query, Query occlusion) {
-    return draw_sample_from(scene, make_rays(scene, spec), count, seed, reference, query, occlusion);
-}
+namespace {
 
-RaySample draw_sample_from(const Scene& scene, const RaySet& all, std::size_t count, std::uint64_t seed,
-                           const Hierarchy& reference, Query query, Query occlusion) {
-    (void)scene;
-    if (count == 0) throw InputError("--count", 0, "a sample needs at least one ray");
-    if (all.rays.empty()) throw InputError(all.described, 0, "the distribution has no rays");
-    const std::vector<std::size_t> idx = pick(all.rays.size(), count, seed);
+/// The sample of `idx` (ascending indices into `all`), its ends found with `reference`.
+RaySample sample_of(const RaySet& all, const std::vector<std::size_t>& idx, std::uint64_t seed, const Hierarchy& reference,
+                    Query query, Query occlusion) {
     RaySample s;
     s.distribution = all.described;
     s.seed = seed;
@@ -109,6 +261,71 @@ RaySample draw_sample_from(const Scene& scene, const RaySet& all, std::size_t co
     }
     find_ends(s, reference);
     return s;
+}
+
+void check_draw(const RaySet& all, std::size_t count) {
+    if (count == 0) throw InputError("--count", 0, "a sample needs at least one ray");
+    if (all.rays.empty()) throw InputError(all.described, 0, "the distribution has no rays");
+}
+
+}  // namespace
+
+RaySample draw_sample(const Scene& scene, const RaySpec& spec, std::size_t count, std::uint64_t seed,
+                      const Hierarchy& reference, Query query, Query occlusion) {
+    // Only the rays are wanted, made with the reference; no pixel at first, to learn whether
+    // the distribution is camera-based (a distribution of another kind ignores the pixels and
+    // is made whole here).
+    const std::vector<std::uint32_t> none;
+    RayMaking making;
+    making.tracer = &reference;
+    making.rays_only = true;
+    making.only_pixels = &none;
+    RaySet all = make_rays(scene, spec, making);
+    if (!all.image_pixels)
+        return draw_sample_from(scene, all, std::min(count, std::max<std::size_t>(all.rays.size() / 2, 1)), seed,
+                                reference, query, occlusion);
+    if (count == 0) throw InputError("--count", 0, "a sample needs at least one ray");
+    // Trace the sample's pixels batch by batch, as many as it takes: the same pixels, rays and
+    // sample as a draw from the whole distribution, for the price of about twice the sample.
+    std::vector<RaySet> parts;
+    const std::vector<std::uint32_t> taken =
+        sample_pixels(all.image_pixels, all.image_width, count, seed, [&](const std::vector<std::uint32_t>& batch) {
+            std::vector<std::uint32_t> sorted = batch;
+            std::sort(sorted.begin(), sorted.end());
+            making.only_pixels = &sorted;
+            parts.push_back(make_rays(scene, spec, making));
+            const std::vector<std::uint32_t>& got = parts.back().pixels;  // ascending
+            std::vector<std::size_t> n(batch.size());
+            for (std::size_t k = 0; k < batch.size(); ++k) {
+                const auto [lo, hi] = std::equal_range(got.begin(), got.end(), batch[k]);
+                n[k] = static_cast<std::size_t>(hi - lo);
+            }
+            return n;
+        });
+    // The taken pixels' rays in the distribution's order: by pixel, each pixel's in its order
+    // (every part is in that order; a pixel is in one part).
+    std::vector<std::pair<std::uint32_t, std::pair<std::size_t, std::size_t>>> order;  // pixel, (part, ray)
+    for (std::size_t k = 0; k < parts.size(); ++k)
+        for (std::size_t i : rays_of_pixels(parts[k], taken)) order.push_back({parts[k].pixels[i], {k, i}});
+    std::stable_sort(order.begin(), order.end(), [](const auto& a, const auto& b) { return a.first < b.first; });
+    RaySet from;
+    from.described = all.described;
+    for (const auto& [pixel, at] : order) {
+        from.rays.push_back(parts[at.first].rays[at.second]);
+        from.kinds.push_back(parts[at.first].kinds[at.second]);
+    }
+    if (from.rays.empty())
+        throw InputError(all.described, 0, "no rays in half the image's pixels to draw a sample from");
+    RaySample s = sample_of(from, pick(from.rays.size(), count, seed), seed, reference, query, occlusion);
+    s.population = 0;  // not counted: the distribution was traced at the sample's pixels only
+    return s;
+}
+
+RaySample draw_sample_from(const Scene& scene, const RaySet& all, std::size_t count, std::uint64_t seed,
+                           const Hierarchy& reference, Query query, Query occlusion) {
+    (void)scene;
+    check_draw(all, count);
+    return sample_of(all, sample_indices(all, count, seed), seed, reference, query, occlusion);
 }
 
 }  // namespace rtcost

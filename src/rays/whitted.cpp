@@ -144,9 +144,11 @@ RayTree join(std::vector<Recorder>& rows, bool record) {
     if (!record) return tree;
     tree.rays.reserve(n);
     tree.kinds.reserve(n);
+    tree.pixels.reserve(n);
     for (Recorder& r : rows) {
         tree.rays.insert(tree.rays.end(), r.rays.begin(), r.rays.end());
         tree.kinds.insert(tree.kinds.end(), r.kinds.begin(), r.kinds.end());
+        tree.pixels.insert(tree.pixels.end(), r.pixels.begin(), r.pixels.end());
         r = Recorder{};  // free as we go: the full SPD tree is ~100 MB
     }
     return tree;
@@ -182,15 +184,18 @@ RayTree whitted_tree(const Hierarchy& h, const WhittedOptions& opt) {
         [&](int j) {
             Recorder& rec = rows[j];
             rec.keep = opt.record;
-            for (int i = 0; i < opt.width; ++i)
-                tracer.trace(eye[static_cast<std::size_t>(j) * opt.width + i], RayKind::Eye, 1, &rec);
+            detail::for_pixels_of_row(j, opt.width, opt.pixels, [&](int, std::size_t pixel) {
+                rec.pixel = static_cast<std::uint32_t>(pixel);
+                tracer.trace(eye[pixel], RayKind::Eye, 1, &rec);
+            });
         },
         opt.progress);
     return join(rows, opt.record);
 }
 
 RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int height, std::uint64_t seed,
-                        int threads, const std::function<void(std::size_t)>& progress, bool test_spawned) {
+                        int threads, const std::function<void(std::size_t)>& progress, bool test_spawned,
+                        const std::vector<std::uint32_t>* pixels) {
     const Scene& scene = h.scene();
     const std::vector<Ray> eye = camera_rays(scene.camera, width, height);
     detail::WhittedTracer tracer(h, 1);
@@ -200,14 +205,14 @@ RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int 
         height, threads,
         [&](int j) {
             Recorder& rec = rows[j];
-            for (int i = 0; i < width; ++i) {
-                const std::size_t pixel = static_cast<std::size_t>(j) * width + i;
+            detail::for_pixels_of_row(j, width, pixels, [&](int, std::size_t pixel) {
+                rec.pixel = static_cast<std::uint32_t>(pixel);
                 const Ray& ray = eye[pixel];
                 Hit hit;
                 h.closest(ray, hit);
                 rec.count(RayKind::Eye, hit.hit());
                 detail::Surface s;
-                if (!tracer.surface(ray, hit, s)) continue;
+                if (!tracer.surface(ray, hit, s)) return;
                 if (which == CameraHitRays::Shadow) {
                     Vec3 o = s.p + s.n * eps;
                     for (const Light& light : scene.lights) {
@@ -217,7 +222,7 @@ RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int 
                         Hit sh;
                         rec.add(r, RayKind::Shadow, test_spawned && h.any(r, sh));
                     }
-                    continue;
+                    return;
                 }
                 PixelRng rng(seed, pixel);
                 Ray r{s.p + s.n * eps, cosine_direction(s.n, rng), 0, kInf};
@@ -229,7 +234,7 @@ RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int 
                     r.tmax = ao;
                     rec.add(r, RayKind::AO, test_spawned && h.any(r, sh));
                 }
-            }
+            });
         },
         progress);
     return join(rows, true);
@@ -244,6 +249,8 @@ RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, const RayMaking& 
     const bool spd = spec.name == "spd";
     int w = spd ? 512 : scene.camera.width, h = spd ? 512 : scene.camera.height;
     if (!spec.size.empty()) parse_size(spec.size, "--size", w, h);
+    const std::size_t image_pixels = spd ? static_cast<std::size_t>(w + 1) * (h + 1) : static_cast<std::size_t>(w) * h;
+    check_pixel_subset(making.only_pixels, image_pixels);
     // Hits are exact, so the rays are the same whichever hierarchy finds them: use a fast one.
     std::unique_ptr<Hierarchy> own;
     if (!making.tracer) own = build_hierarchy(scene, "bvh-sah");
@@ -262,13 +269,14 @@ RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, const RayMaking& 
         opt.threads = threads;
         opt.progress = rows_done;
         opt.shadow_tests = !making.rays_only;
+        opt.pixels = making.only_pixels;
         tree = whitted_tree(bvh, opt);
         described = fmt::format("spd {}x{} ({}x{} corner eye rays, depth 5)", w, h, w + 1, h + 1);
     } else {
         CameraHitRays which = spec.name == "shadow"    ? CameraHitRays::Shadow
                               : spec.name == "diffuse" ? CameraHitRays::Diffuse
                                                        : CameraHitRays::AO;
-        tree = camera_hit_rays(bvh, which, w, h, spec.seed, threads, rows_done, !making.rays_only);
+        tree = camera_hit_rays(bvh, which, w, h, spec.seed, threads, rows_done, !making.rays_only, making.only_pixels);
         described = which == CameraHitRays::Shadow ? fmt::format("shadow rays of camera {}x{} hits", w, h)
                                                    : fmt::format("{} rays of camera {}x{} hits seed {}", spec.name, w, h,
                                                                  spec.seed);
@@ -276,6 +284,9 @@ RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, const RayMaking& 
     RaySet set;
     set.rays = std::move(tree.rays);
     set.kinds = std::move(tree.kinds);
+    set.pixels = std::move(tree.pixels);
+    set.image_pixels = image_pixels;
+    set.image_width = static_cast<std::size_t>(spd ? w + 1 : w);
     set.described = std::move(described);
     for (int k = 0; k < kRayKinds; ++k) {
         RayKind kind = static_cast<RayKind>(k);

@@ -1,6 +1,8 @@
 #pragma once
 // The Whitted recursion shared by the SPD ray tree (which records rays) and the renderer (which
 // keeps the colour): one code path, so the image shows exactly the rays that are counted.
+#include <algorithm>
+#include <cstdint>
 #include <functional>
 #include <vector>
 
@@ -14,6 +16,8 @@ struct Recorder {
     bool keep = true;
     std::vector<Ray> rays;
     std::vector<RayKind> kinds;
+    std::vector<std::uint32_t> pixels;  ///< per ray, `pixel` when it was added
+    std::uint32_t pixel = 0;            ///< the pixel whose rays are being recorded
     KindCounts counts;
     void count(RayKind k, bool hit) {
         ++counts.rays[static_cast<int>(k)];
@@ -24,6 +28,7 @@ struct Recorder {
         if (!keep) return;
         rays.push_back(r);
         kinds.push_back(k);
+        pixels.push_back(pixel);
     }
 };
 
@@ -57,6 +62,20 @@ private:
 
 /// A cosine-weighted unit direction about unit `n`.
 Vec3 cosine_direction(Vec3 n, ItemRng& rng);
+
+/// Calls `pixel(i, index)` for every pixel i of image row j (width pixels a row) that `only`
+/// lists (ascending), or for every pixel of the row when `only` is null; index = j width + i.
+template <class F>
+void for_pixels_of_row(int j, int width, const std::vector<std::uint32_t>* only, F&& pixel) {
+    const std::size_t first = static_cast<std::size_t>(j) * static_cast<std::size_t>(width);
+    if (!only) {
+        for (int i = 0; i < width; ++i) pixel(i, first + static_cast<std::size_t>(i));
+        return;
+    }
+    auto at = std::lower_bound(only->begin(), only->end(), first);
+    for (; at != only->end() && *at < first + static_cast<std::size_t>(width); ++at)
+        pixel(static_cast<int>(*at - first), static_cast<std::size_t>(*at));
+}
 
 /// Calls row(j) for every j in [0, rows) on `threads` threads (0: all cores), reporting rows done.
 void run_rows(int rows, int threads, const std::function<void(int)>& row,
