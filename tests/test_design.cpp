@@ -200,12 +200,23 @@ TEST(Design, EveryDesignIsNoWorseOnItsSampleThanItsYardstick) {
             }
         }
     }
+    // There the design keeps the yardstick's tree, or one the model predicts cheaper on the
+    // sample (above) that also counts no more operations on the rays the sample never saw (a
+    // tree stopped far too early counts several times more).
     const Scene balls = builtin_scene("balls", 4);
-    const std::vector<std::string> set{"rays=camera", "size=128x128"};
-    for (const auto& [designed, yardstick] :
-         std::vector<std::pair<std::string, std::string>>{{"octree-design", "octree"}, {"bsp-design", "bsp"}})
-        expect_same_tree(build_hierarchy(balls, designed, set)->model_tree(), build_hierarchy(balls, yardstick)->model_tree(),
-                         designed);
+    DesignOptions o;
+    o.rays.name = "camera";
+    o.rays.size = "128x128";
+    o.families = {"octree", "bsp"};
+    for (std::uint64_t seed : {1u, 2u}) {
+        o.seed = seed;
+        const DesignResult r = design(balls, o);
+        ASSERT_EQ(r.rows.size(), 2u);
+        for (const DesignRow& row : r.rows) {
+            EXPECT_GT(row.yardstick_measured, 300) << row.family;
+            EXPECT_LE(row.designed_measured, row.yardstick_measured * (1 + 1e-9)) << row.family << " seed " << seed;
+        }
+    }
 }
 
 TEST(Design, DesignReportsEachFamilyOnDisjointRays) {
