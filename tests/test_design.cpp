@@ -1,6 +1,11 @@
 // The designed hierarchies: exact hits like every hierarchy (closest and any-hit), the same
 // structure for the same seed, the SAH's tree where the sample is given no weight, a grid
 // resolution no worse on the sample than the formula's, and `rtcost design`'s rows.
+#include <type_traits>
+
+#include "../src/design/sample_reach.hpp"
+#include "../src/hierarchy/bsp/bsp.hpp"
+#include "../src/hierarchy/octree/octree.hpp"
 #include "rtcost/design.hpp"
 #include "rtcost/evaluate.hpp"
 #include "rtcost/sample.hpp"
@@ -215,6 +220,36 @@ TEST(Design, EveryDesignIsNoWorseOnItsSampleThanItsYardstick) {
         for (const DesignRow& row : r.rows) {
             EXPECT_GT(row.yardstick_measured, 300) << row.family;
             EXPECT_LE(row.designed_measured, row.yardstick_measured * (1 + 1e-9)) << row.family << " seed " << seed;
+        }
+    }
+}
+
+// The octree and BSP designs compare themselves with the yardstick's tree built only where the
+// sample reaches: it must predict the sample exactly as the whole tree does, and be smaller.
+TEST(Design, TheYardstickBuiltWhereTheSampleReachesPredictsAsTheWholeTree) {
+    for (const char* scene : {"builtin:balls:2", "builtin:tetra:4"}) {
+        const Scene s = load_scene(scene);
+        for (const char* rays : {"rays=camera", "rays=shadow", "rays=spd"}) {
+            Params p(design_param_specs(), {rays, "size=48x48", "sample=400"});
+            const DesignInput in = draw_design_input(s, p);
+            auto check = [&](auto tag, int depth, int prims) {
+                using H = typename decltype(tag)::type;
+                subdiv::CellOptions whole;
+                whole.max_depth = depth;
+                whole.max_prims = prims;
+                designing::SampleReach reach(in.sample, s.bounds());
+                subdiv::CellOptions some = whole;
+                some.reached = [&reach](const Box3& cell, int d) { return reach(cell, d); };
+                const H a(s, whole), b(s, some);
+                const std::string what = std::string(scene) + " " + rays + " " + std::string(a.name());
+                EXPECT_FALSE(a.partial()) << what;
+                EXPECT_TRUE(b.partial()) << what;
+                EXPECT_LT(b.structure().leaves, a.structure().leaves) << what;
+                EXPECT_EQ(sample_cost(b, s, in.sample, in.costs), sample_cost(a, s, in.sample, in.costs)) << what;
+                EXPECT_EQ(sample_cost(b, s, in.sample, UnitCosts{}), sample_cost(a, s, in.sample, UnitCosts{})) << what;
+            };
+            check(std::type_identity<octree::Octree>{}, 8, 1);
+            check(std::type_identity<bsp::Bsp>{}, 20, 2);
         }
     }
 }

@@ -29,6 +29,7 @@
 
 #include <fmt/format.h>
 
+#include <functional>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -47,6 +48,11 @@ struct CellOptions {
     bool mailbox = false;
     double growth = 6;  ///< see kGrowthParam
     SplitTest split_pays;  ///< when set, a cell is split only where this says it pays
+    /// When set, a cell that would be split is left unbuilt where this says no ray of a sample
+    /// reaches it (`reached(cell, depth)`, asked depth first): an empty leaf that the model tree
+    /// marks pruned (ModelNode::pruned). Such a tree predicts the sample as the whole tree does,
+    /// for a fraction of its build, and must not be traced (partial()).
+    std::function<bool(const Box3&, int)> reached;
     std::string name;  ///< the registered name (a designed variant's)
 };
 
@@ -79,6 +85,8 @@ public:
     bool emit_model(ModelSink& sink) const override;
 
     const Box3& root() const { return root_; }
+    /// Some cells were left unbuilt (CellOptions::reached): a tree for the model only.
+    bool partial() const { return !unbuilt_.empty(); }
     const std::vector<Node>& nodes() const { return nodes_; }
     const std::vector<std::uint32_t>& refs() const { return refs_; }
 
@@ -205,6 +213,7 @@ private:
     Box3 root_;
     std::vector<Node> nodes_;
     std::vector<std::uint32_t> refs_;
+    std::vector<std::uint8_t> unbuilt_;  ///< per node (up to the last one unbuilt): left unbuilt
     bool capped_ = false;  ///< the references or nodes bound stopped the build somewhere
 };
 
@@ -229,6 +238,11 @@ void CellTree<Derived, NodeT>::build(std::uint32_t node, const Box3& cell, int d
     const int k = self().split(cell, depth, refs, as, kids, mask, counts);
     if (k == 0) return make_leaf(node, refs);
     if (o_.split_pays && !o_.split_pays(cell, refs.size(), kids, counts.data(), k)) return make_leaf(node, refs);
+    if (o_.reached && !o_.reached(cell, depth)) {
+        if (unbuilt_.size() < nodes_.size()) unbuilt_.resize(nodes_.size(), 0);
+        unbuilt_[node] = 1;
+        return make_leaf(node, {});
+    }
     std::vector<std::uint32_t> child[8];
     for (int j = 0; j < k; ++j) child[j] = Assigner::select(refs, mask, j, counts[j]);
     std::vector<std::uint32_t>().swap(refs);  // free the parent's list before descending
@@ -270,6 +284,7 @@ bool CellTree<Derived, NodeT>::emit_model(ModelSink& sink) const {
         m.region = region;
         m.step = true;
         m.count = n.count;
+        m.pruned = i < unbuilt_.size() && unbuilt_[i];
         sink.node(m, std::span<const std::uint32_t>(refs_).subspan(n.index, n.count));
     };
     emit(emit, 0, root_);

@@ -2,11 +2,12 @@
 // builders, a cell split only where the cost model, with visit probabilities from a sample of
 // the given rays, says the split pays (design/cell_rays.hpp) -- instead of splitting down to
 // max_prims or max_depth -- or, where the model predicts it cheaper on the sample, the tree the
-// builder makes with the yardstick's termination (design/cheaper.hpp).
+// builder makes with the yardstick's termination.
 #include "../bsp/bsp.hpp"
 #include "../octree/octree.hpp"
 #include "design/cell_rays.hpp"
-#include "design/cheaper.hpp"
+#include "design/sample_reach.hpp"
+#include "model/model_internal.hpp"
 
 namespace rtcost {
 namespace {
@@ -19,8 +20,11 @@ std::vector<ParamSpec> specs(int default_depth, int max_depth, int default_prims
 }
 
 // Builds with the model's split test (the test and the sample it reads live only during the
-// build) and with the yardstick's depth and leaf size (`usual_depth`, `usual_prims`), and keeps
-// the one the model predicts cheaper on the sample.
+// build) and compares it, on the sample, with the tree the builder makes with the yardstick's
+// depth and leaf size (`usual_depth`, `usual_prims`); keeps the one the model predicts cheaper
+// (a tie keeps the design, as designing::cheaper_on_sample does). The yardstick's tree is first
+// built only where the sample reaches (a yardstick octree can be a hundred times the design's
+// size, all of it built only to be compared), and whole only when it is kept.
 template <class H>
 std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, double planes, const char* name,
                                  int usual_depth, int usual_prims) {
@@ -34,7 +38,24 @@ std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, double planes,
     o.split_pays = [&cells](const Box3& cell, std::size_t n, const Box3* children, const std::size_t* counts, int k) {
         return cells.split_pays(cell, n, children, counts, k);
     };
-    return designing::cheaper_on_sample(std::make_unique<H>(s, o), std::make_unique<H>(s, usual), s, in);
+    auto designed = std::make_unique<H>(s, o);
+    const double designed_cost = sample_cost(*designed, s, in.sample, in.costs);
+    designing::SampleReach reach(in.sample, s.bounds());
+    subdiv::CellOptions reached = usual;
+    reached.reached = [&reach](const Box3& cell, int depth) { return reach(cell, depth); };
+    std::unique_ptr<H> yardstick = std::make_unique<H>(s, reached);
+    double yardstick_cost;
+    try {
+        yardstick_cost = sample_cost(*yardstick, s, in.sample, in.costs);
+    } catch (const model::PrunedNodeReached&) {
+        // A replay went where no segment was thought to reach (it cannot, but rounding is
+        // rounding): the whole tree.
+        yardstick = std::make_unique<H>(s, usual);
+        yardstick_cost = sample_cost(*yardstick, s, in.sample, in.costs);
+    }
+    if (!(yardstick_cost < designed_cost)) return designed;
+    if (yardstick->partial()) yardstick = std::make_unique<H>(s, usual);
+    return yardstick;
 }
 
 // The operations of one interior visit: an octree node's three planes, a BSP node's one.
