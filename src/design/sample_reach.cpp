@@ -2,7 +2,8 @@
 #include "sample_reach.hpp"
 
 #include <algorithm>
-#include <cmath>
+
+#include "model/model_internal.hpp"
 
 namespace rtcost::designing {
 
@@ -13,11 +14,7 @@ SampleReach::SampleReach(const RaySample& sample, const Box3& root) : sample_(sa
     for (std::size_t i = 0; i < n; ++i) {
         const Ray& r = sample.rays.rays[i];
         inv_.emplace_back(r);
-        // As reached_model_tree's ReachCollector, with the subdivisions' culling traversal.
-        float end = r.tmax;
-        if (sample.queries[i] == Query::Closest && sample.t_end[i] < r.tmax)
-            end = std::min(r.tmax, sample.t_end[i] + 1e-4f * std::fabs(sample.t_end[i]) + 1e-6f);
-        ends_[i] = end;
+        ends_[i] = model::replay_end(sample, i, true);  // the subdivisions' traversals cull
     }
     const Vec3 e = root.extent();
     grow_ = 1e-5f * std::max({e.x, e.y, e.z, 1e-30f});

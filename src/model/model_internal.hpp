@@ -2,18 +2,32 @@
 // What the model's files share (not public API): Crofton geometry, the recursion over a
 // materialised model tree and its per-node probabilities, 5D beam weights.
 #include <algorithm>
+#include <cmath>
 #include <array>
 #include <span>
 #include <string>
 #include <vector>
 
 #include "rtcost/model.hpp"
+#include "rtcost/sample.hpp"
 
 namespace rtcost {
 struct RaySample;
 }
 
 namespace rtcost::model {
+
+/// How far the segments replay can follow ray `i` of `sample` (reached_model_tree prunes what
+/// no ray reaches this far). A closest-hit search with culling (`cull`) visits no region that
+/// starts at or beyond its hit, and cannot pass the nearest crossing, t_end, without having
+/// found it in a region that holds it; an any-hit search ends at whichever occluder it finds
+/// first, and one that visits everything never ends: tmax. A margin covers rounding; a replay
+/// that still reaches a pruned node throws PrunedNodeReached.
+inline float replay_end(const RaySample& sample, std::size_t i, bool cull) {
+    const Ray& r = sample.rays.rays[i];
+    if (!(cull && sample.queries[i] == Query::Closest && sample.t_end[i] < r.tmax)) return r.tmax;
+    return std::min(r.tmax, sample.t_end[i] + 1e-4f * std::fabs(sample.t_end[i]) + 1e-6f);
+}
 
 /// The cost vector's scalar fields (its `prim` array aside), for sums field by field.
 inline constexpr double CostVector::*kCostFields[] = {&CostVector::box,      &CostVector::plane, &CostVector::hop,

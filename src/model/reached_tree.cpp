@@ -40,17 +40,7 @@ public:
         for (std::size_t i = 0; i < n; ++i) {
             const Ray& r = sample_.rays.rays[i];
             inv_.emplace_back(r);
-            // How far the probe can follow the ray. A closest-hit search with culling visits no
-            // region that starts at or beyond its hit, and cannot pass the nearest crossing,
-            // t_end, without having found it in a region that holds it; an any-hit search ends
-            // at whichever occluder it finds first, and one that visits everything never ends.
-            // A margin covers rounding; a replay that still reaches a pruned node falls back on
-            // the whole tree (predict_segments throws).
-            const bool closest = sample_.queries[i] == Query::Closest && f.cull;
-            float end = r.tmax;
-            if (closest && sample_.t_end[i] < r.tmax)
-                end = std::min(r.tmax, sample_.t_end[i] + 1e-4f * std::fabs(sample_.t_end[i]) + 1e-6f);
-            ends_[i] = end;
+            ends_[i] = model::replay_end(sample_, i, f.cull);
         }
         return true;
     }
