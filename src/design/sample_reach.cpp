@@ -3,19 +3,10 @@
 
 #include <algorithm>
 
-#include "model/model_internal.hpp"
-
 namespace rtcost::designing {
 
-SampleReach::SampleReach(const RaySample& sample, const Box3& root) : sample_(sample) {
-    const std::size_t n = sample.size();
-    inv_.reserve(n);
-    ends_.resize(n);
-    for (std::size_t i = 0; i < n; ++i) {
-        const Ray& r = sample.rays.rays[i];
-        inv_.emplace_back(r);
-        ends_[i] = model::replay_end(sample, i, true);  // the subdivisions' traversals cull
-    }
+SampleReach::SampleReach(const RaySample& sample, const Box3& root)
+    : sample_(sample), seg_(sample, true) {  // the subdivisions' traversals cull
     const Vec3 e = root.extent();
     grow_ = 1e-5f * std::max({e.x, e.y, e.z, 1e-30f});
 }
@@ -28,7 +19,7 @@ bool SampleReach::operator()(const Box3& cell, int depth) {
     Box3 grown = cell;
     for (int a = 0; a < 3; ++a) grown.lo[a] -= grow_, grown.hi[a] += grow_;
     auto meets = [&](std::uint32_t r) {
-        return box_entry(grown, inv_[r], sample_.rays.rays[r].tmin, ends_[r]) != kInf;
+        return box_entry(grown, seg_.inv[r], sample_.rays.rays[r].tmin, seg_.ends[r]) != kInf;
     };
     if (depth == 0) {
         for (std::uint32_t r = 0; r < sample_.size(); ++r)

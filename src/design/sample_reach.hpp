@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "../model/model_internal.hpp"
 #include "rtcost/sample.hpp"
 
 namespace rtcost::designing {
@@ -21,8 +22,7 @@ public:
 
 private:
     const RaySample& sample_;
-    std::vector<RayInv> inv_;
-    std::vector<float> ends_;
+    model::ReplaySegments seg_;
     float grow_;
     std::vector<std::vector<std::uint32_t>> by_depth_;  // the segments reaching the last cell at each depth
 };

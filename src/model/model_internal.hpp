@@ -2,8 +2,8 @@
 // What the model's files share (not public API): Crofton geometry, the recursion over a
 // materialised model tree and its per-node probabilities, 5D beam weights.
 #include <algorithm>
-#include <cmath>
 #include <array>
+#include <cmath>
 #include <span>
 #include <string>
 #include <vector>
@@ -17,17 +17,30 @@ struct RaySample;
 
 namespace rtcost::model {
 
-/// How far the segments replay can follow ray `i` of `sample` (reached_model_tree prunes what
-/// no ray reaches this far). A closest-hit search with culling (`cull`) visits no region that
-/// starts at or beyond its hit, and cannot pass the nearest crossing, t_end, without having
-/// found it in a region that holds it; an any-hit search ends at whichever occluder it finds
-/// first, and one that visits everything never ends: tmax. A margin covers rounding; a replay
-/// that still reaches a pruned node throws PrunedNodeReached.
-inline float replay_end(const RaySample& sample, std::size_t i, bool cull) {
-    const Ray& r = sample.rays.rays[i];
-    if (!(cull && sample.queries[i] == Query::Closest && sample.t_end[i] < r.tmax)) return r.tmax;
-    return std::min(r.tmax, sample.t_end[i] + 1e-4f * std::fabs(sample.t_end[i]) + 1e-6f);
-}
+/// The segments of a sample's rays as far as the segments replay can follow them, for finding
+/// the regions they reach (reached_model_tree prunes what no ray reaches): each ray's
+/// reciprocal direction and end. A closest-hit search with culling (`cull`) visits no region
+/// that starts at or beyond its hit, and cannot pass the nearest crossing, t_end, without
+/// having found it in a region that holds it; an any-hit search ends at whichever occluder it
+/// finds first, and one that visits everything never ends: tmax. A margin covers rounding; a
+/// replay that still reaches a pruned node throws PrunedNodeReached.
+struct ReplaySegments {
+    std::vector<RayInv> inv;
+    std::vector<float> ends;
+
+    ReplaySegments() = default;
+    ReplaySegments(const RaySample& sample, bool cull) {
+        inv.reserve(sample.size());
+        ends.reserve(sample.size());
+        for (std::size_t i = 0; i < sample.size(); ++i) {
+            const Ray& r = sample.rays.rays[i];
+            inv.emplace_back(r);
+            const bool ends_early = cull && sample.queries[i] == Query::Closest && sample.t_end[i] < r.tmax;
+            ends.push_back(ends_early ? std::min(r.tmax, sample.t_end[i] + 1e-4f * std::fabs(sample.t_end[i]) + 1e-6f)
+                                      : r.tmax);
+        }
+    }
+};
 
 /// The cost vector's scalar fields (its `prim` array aside), for sums field by field.
 inline constexpr double CostVector::*kCostFields[] = {&CostVector::box,      &CostVector::plane, &CostVector::hop,

@@ -34,14 +34,7 @@ public:
         ModelCollector::begin(f);
         // 5D trees classify rays instead of clipping them: kept whole.
         whole_ = f.one_path;
-        const std::size_t n = sample_.size();
-        inv_.reserve(n);
-        ends_.resize(n);
-        for (std::size_t i = 0; i < n; ++i) {
-            const Ray& r = sample_.rays.rays[i];
-            inv_.emplace_back(r);
-            ends_[i] = model::replay_end(sample_, i, f.cull);
-        }
+        seg_ = model::ReplaySegments(sample_, f.cull);
         return true;
     }
 
@@ -55,20 +48,20 @@ private:
         std::vector<Reach>& out = by_depth_[depth];
         out.clear();
         auto add = [&](std::uint32_t ray, Segment s) {
-            s = clip_segment(inv_[ray], m.region, s);
+            s = clip_segment(seg_.inv[ray], m.region, s);
             if (s.empty()) return;
             // The node's children see the segment within its bounding volume.
-            if (m.has_bv) s = clip_segment(inv_[ray], m.bv, s);
+            if (m.has_bv) s = clip_segment(seg_.inv[ray], m.bv, s);
             out.push_back({ray, s});
         };
         if (depth == 0) {
-            for (std::uint32_t i = 0; i < inv_.size(); ++i) {
-                const Segment whole{sample_.rays.rays[i].tmin, ends_[i]};
+            for (std::uint32_t i = 0; i < seg_.inv.size(); ++i) {
+                const Segment whole{sample_.rays.rays[i].tmin, seg_.ends[i]};
                 if (t_.gated) {
                     add(i, whole);
                 } else {
                     Segment s = whole;  // every ray enters an ungated root
-                    if (m.has_bv) s = clip_segment(inv_[i], m.bv, s);
+                    if (m.has_bv) s = clip_segment(seg_.inv[i], m.bv, s);
                     out.push_back({i, s});
                 }
             }
@@ -86,8 +79,7 @@ private:
 
     const RaySample& sample_;
     bool whole_ = false;
-    std::vector<RayInv> inv_;
-    std::vector<float> ends_;
+    model::ReplaySegments seg_;
     std::vector<std::vector<Reach>> by_depth_;
 };
 
