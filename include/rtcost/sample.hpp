@@ -70,6 +70,11 @@ RaySample draw_sample_from(const Scene& scene, const RaySet& all, std::size_t co
 /// too few (a camera-based distribution's half of the pixels may hold fewer).
 std::size_t sample_size(const RaySet& all, std::size_t count, std::uint64_t seed);
 
+/// The `count` draw_sample asks draw_sample_from for, from the distribution `all` (made whole):
+/// `count` for a camera-based one (its draw takes at most half the pixels), at most half the
+/// rays of another. draw_sample's sample is then draw_sample_from(all, that, seed)'s.
+std::size_t draw_sample_count(const RaySet& all, std::size_t count);
+
 /// Finds how each of `s`'s rays ends (t_end and crossings, replacing any) with `reference`, an
 /// exact hierarchy over the scene, tracing with the rays' own tmin and tmax.
 void find_ends(RaySample& s, const Hierarchy& reference);

@@ -32,14 +32,6 @@ std::vector<std::string> design_set(const DesignOptions& opt, const Scene& scene
     return set;
 }
 
-// The size of the sample draw_design_input draws (draw_sample): as asked for a camera-based
-// distribution, at most half the rays of another; no more than the rays the draw can take.
-std::size_t design_sample_size(const Scene& scene, const RaySpec& rays, std::size_t count, std::uint64_t seed) {
-    const RaySet all = make_rays(scene, rays);
-    const std::size_t asked = all.image_pixels ? count : std::min(count, std::max<std::size_t>(all.rays.size() / 2, 1));
-    return sample_size(all, asked, seed);
-}
-
 }  // namespace
 
 std::vector<std::string> design_families() {
@@ -67,6 +59,9 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
     res.designed_for = opt.costs_file.empty() ? "each family's default" : opt.costs_file;
     UnitCosts costs;
     if (res.calibrated) costs = UnitCosts::read(opt.costs_file);
+    // The size of the sample each design draws (draw_design_input: draw_sample), the same for all.
+    const RaySet all = make_rays(scene, opt.rays);
+    const std::size_t segments = sample_size(all, draw_sample_count(all, opt.sample), opt.seed);
     for (const auto& fam : families) {
         const Family* f = nullptr;
         for (const Family& k : kFamilies)
@@ -87,7 +82,7 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
         eo.on_step = opt.on_step;
         // The evaluation draws the designed hierarchy's sample again (draw_sample's) and leaves
         // it out, so the test rays are the ones the design never saw.
-        eo.segments = design_sample_size(scene, opt.rays, opt.sample, opt.seed);
+        eo.segments = segments;
         const EvalResult r = evaluate(scene, opt.rays, eo);
         res.distribution = r.distribution;
         res.sample = r.sample_rays;

@@ -48,12 +48,6 @@ bool Hierarchy::modelled() const {
 
 ModelTree Hierarchy::model_tree() const {
     ModelTree t;
-    // Room for the whole tree at once (a hint: a model tree may have more levels than the
-    // hierarchy has nodes): fresh memory is paid for page by page, and a growing array pays for
-    // its every size.
-    const StructureStats st = structure();
-    t.nodes.reserve(st.interior + st.leaves);
-    t.prims.reserve(st.references);
     ModelCollector c(t);
     emit_model(c);
     return t;

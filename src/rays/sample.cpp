@@ -198,6 +198,10 @@ std::size_t sample_size(const RaySet& all, std::size_t count, std::uint64_t seed
     return sample_indices(all, count, seed).size();
 }
 
+std::size_t draw_sample_count(const RaySet& all, std::size_t count) {
+    return all.image_pixels ? count : std::min(count, std::max<std::size_t>(all.rays.size() / 2, 1));
+}
+
 RaySet rays_outside_sample(const RaySet& all, std::size_t count, std::uint64_t seed) {
     // A camera-based distribution's sample leaves out every ray of its pixels, sampled or not:
     // the test rays are those of the pixels it never traced.
@@ -282,8 +286,7 @@ RaySample draw_sample(const Scene& scene, const RaySpec& spec, std::size_t count
     making.only_pixels = &none;
     RaySet all = make_rays(scene, spec, making);
     if (!all.image_pixels)
-        return draw_sample_from(scene, all, std::min(count, std::max<std::size_t>(all.rays.size() / 2, 1)), seed,
-                                reference, query, occlusion);
+        return draw_sample_from(scene, all, draw_sample_count(all, count), seed, reference, query, occlusion);
     if (count == 0) throw InputError("--count", 0, "a sample needs at least one ray");
     // Trace the sample's pixels batch by batch, as many as it takes: the same pixels, rays and
     // sample as a draw from the whole distribution, for the price of about twice the sample.

@@ -48,7 +48,7 @@ struct CellOptions {
     bool mailbox = false;
     double growth = 6;  ///< see kGrowthParam
     SplitTest split_pays;  ///< when set, a cell is split only where this says it pays
-    /// When set, a cell that would be split is left unbuilt where this says no ray of a sample
+    /// When set, a cell above the leaf size and depth is left unbuilt where this says no ray of a sample
     /// reaches it (`reached(cell, depth)`, asked depth first): an empty leaf that the model tree
     /// marks pruned (ModelNode::pruned). Such a tree predicts the sample as the whole tree does,
     /// for a fraction of its build, and must not be traced (partial()).
@@ -235,14 +235,14 @@ void CellTree<Derived, NodeT>::build(std::uint32_t node, const Box3& cell, int d
     Box3 kids[8];
     std::vector<std::uint8_t> mask;
     std::array<std::size_t, 8> counts;
-    const int k = self().split(cell, depth, refs, as, kids, mask, counts);
-    if (k == 0) return make_leaf(node, refs);
-    if (o_.split_pays && !o_.split_pays(cell, refs.size(), kids, counts.data(), k)) return make_leaf(node, refs);
-    if (o_.reached && !o_.reached(cell, depth)) {
+    if (o_.reached && !o_.reached(cell, depth)) {  // before the split's work
         if (unbuilt_.size() < nodes_.size()) unbuilt_.resize(nodes_.size(), 0);
         unbuilt_[node] = 1;
         return make_leaf(node, {});
     }
+    const int k = self().split(cell, depth, refs, as, kids, mask, counts);
+    if (k == 0) return make_leaf(node, refs);
+    if (o_.split_pays && !o_.split_pays(cell, refs.size(), kids, counts.data(), k)) return make_leaf(node, refs);
     std::vector<std::uint32_t> child[8];
     for (int j = 0; j < k; ++j) child[j] = Assigner::select(refs, mask, j, counts[j]);
     std::vector<std::uint32_t>().swap(refs);  // free the parent's list before descending
