@@ -30,7 +30,9 @@ bool asks_for_a_big_build(const std::string& a) {
             if (ec != std::errc()) return false;
             p = q + 1;
         }
-        return r[0] * r[1] * r[2] > (1ll << 20);
+        // In doubles: the product of three parsed values overflows long long.
+        return static_cast<double>(r[0]) * static_cast<double>(r[1]) * static_cast<double>(r[2]) >
+               static_cast<double>(1ll << 20);
     }
     return false;
 }
