@@ -1,5 +1,6 @@
-// `grid-design`: the resolution search over candidate grids, each predicted on the design
-// sample through its model tree (no primitive tests), and the registration.
+// `grid-design`: the resolution search over candidate grids, each priced on the design sample
+// by its own traversal with the sample's known crossings (no primitive tests), and the
+// registration.
 #include "grid_design.hpp"
 
 #include <algorithm>
@@ -8,10 +9,60 @@
 
 namespace rtcost::grid {
 
+SampleReplay::SampleReplay(const Scene& s, const RaySample& sample, const UnitCosts& costs)
+    : sample_(sample), costs_(costs), kinds_(s.size()) {
+    // One byte per primitive: the scene's records are far larger, and a replay looks a kind up
+    // for every reference of every cell it visits.
+    for (std::uint32_t id = 0; id < s.size(); ++id) kinds_[id] = static_cast<std::uint8_t>(s.kind(id));
+}
+
+double SampleReplay::cost(const Grid& g) const {
+    RayCounters counters;
+    Count counting{counters};
+    for (std::size_t i = 0; i < sample_.size(); ++i) {
+        const Query q = sample_.queries[i];
+        // A closest-hit query's crossings are nearest first; only the nearest one matters: a
+        // grid is left after the cell whose exit reaches the nearest hit, and that cell holds
+        // the nearest crossing's primitive (it holds the crossing point), whichever farther
+        // crossings were found before it.
+        const std::span<const Crossing> all = sample_.crossings_of(i);
+        const std::span<const Crossing> known = q == Query::Closest ? all.first(std::min<std::size_t>(all.size(), 1)) : all;
+        // The segments estimator's answer to a primitive test (model/probe.cpp's oracle): a
+        // known crossing nearer than the hit so far and before tmax.
+        auto test = [&](std::uint32_t id, const Ray& ray, Hit& hit, Count& c) {
+            c.prim(static_cast<PrimKind>(kinds_[id]));
+            for (const Crossing& x : known)
+                if (x.prim == id) {
+                    if (x.t < hit.t && x.t < ray.tmax) {
+                        hit.t = x.t;
+                        hit.prim = static_cast<std::int32_t>(id);
+                        return true;
+                    }
+                    return false;
+                }
+            return false;
+        };
+        const Ray& ray = sample_.rays.rays[i];
+        Hit hit;
+        switch (q) {
+            case Query::Closest: g.trace_with<Count, Query::Closest>(ray, hit, counting, test); break;
+            case Query::Any: g.trace_with<Count, Query::Any>(ray, hit, counting, test); break;
+            case Query::All: g.trace_with<Count, Query::All>(ray, hit, counting, test); break;
+        }
+    }
+    counters.rays = sample_.size();
+    return costs_.scalar(measured_cost(counters));
+}
+
+double replay_cost(const Grid& g, const Scene& s, const RaySample& sample, const UnitCosts& costs) {
+    return SampleReplay(s, sample, costs).cost(g);
+}
+
 std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, spatial::Assign assign, bool mailbox,
                                          std::uint64_t max_cells) {
     std::map<std::array<int, 3>, double> seen;
     const Box3 box = s.bounds();
+    const SampleReplay replay(s, in.sample, in.costs);
     auto cost = [&](std::array<int, 3> r) -> double {
         for (int a = 0; a < 3; ++a) r[a] = std::clamp(r[a], 1, kMaxRes);
         if (auto it = seen.find(r); it != seen.end()) return it->second;
@@ -19,19 +70,30 @@ std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, 
         double c = kInf;
         if (cells <= max_cells) {
             const Grid g(s, r, assign, mailbox);
-            c = sample_cost(g, s, in.sample, in.costs);
+            c = replay.cost(g);
         }
         seen[r] = c;
         return c;
     };
     std::array<int, 3> best{1, 1, 1};
     double best_cost = kInf;
-    // Up to the cap (a denser candidate costs nothing: it is never built).
-    for (double density : {0.125, 0.25, 0.5, 1.0, 2.0, 4.0, 8.0, 16.0, 32.0, 64.0}) {
+    // From one cell per primitive, doubling while the cost falls, else halving while it falls
+    // (the sample's cost is unimodal in the density on every scene tried; the coarsest grids
+    // cost the most to replay, the finest the most to build). A candidate above the cap costs
+    // nothing: it is never built, and ends the doubling.
+    auto at = [&](double density) {
         const std::array<int, 3> r = resolution("hetero", density, s.size(), box);
         const double c = cost(r);
-        if (c < best_cost) best_cost = c, best = r;
-    }
+        const bool better = c < best_cost;
+        if (better) best_cost = c, best = r;
+        return better;
+    };
+    at(1.0);
+    bool finer = false;
+    for (double density = 2.0; density <= 64.0 && at(density); density *= 2) finer = true;
+    if (!finer)
+        for (double density = 0.5; density >= 0.125 && at(density); density /= 2) {
+        }
     // Coordinate descent: each axis up or down by a third until no step lowers the cost.
     for (int round = 0; round < 6; ++round) {
         bool improved = false;

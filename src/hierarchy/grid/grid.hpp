@@ -60,7 +60,18 @@ public:
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        return mailbox_ ? walk<C, Q, true>(ray, hit, counting) : walk<C, Q, false>(ray, hit, counting);
+        return trace_with<C, Q>(ray, hit, counting, [this](std::uint32_t id, const Ray& r, Hit& h, C& c) {
+            return test_prim(*scene_, id, r, h, c);
+        });
+    }
+
+    /// The traversal with the primitive test supplied by the caller: `test(id, ray, hit,
+    /// counting)` counts its test, records a hit nearer than `hit.t` and says whether it found
+    /// one. grid-design replays a ray sample this way, answering from the rays' known crossings
+    /// instead of intersecting: a candidate grid's cost on the sample without its model tree.
+    template <class C, Query Q, class PrimTest>
+    bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest&& test) const {
+        return mailbox_ ? walk<C, Q, true>(ray, hit, counting, test) : walk<C, Q, false>(ray, hit, counting, test);
     }
 
 protected:
@@ -94,8 +105,8 @@ private:
         return static_cast<int>(f);
     }
 
-    template <class C, Query Q, bool kMailbox>
-    bool walk(const Ray& ray, Hit& hit, C& counting) const {
+    template <class C, Query Q, bool kMailbox, class PrimTest>
+    bool walk(const Ray& ray, Hit& hit, C& counting, PrimTest& test) const {
         counting.box();
         if (empty_) return false;
         const RayInv ri(ray);
@@ -156,7 +167,7 @@ private:
                 if constexpr (kMailbox) {
                     if (!mb->first_visit(id)) continue;
                 }
-                if (test_prim(*scene_, id, ray, hit, counting)) {
+                if (test(id, ray, hit, counting)) {
                     found = true;
                     if constexpr (Q == Query::Any) return true;
                 }
