@@ -95,6 +95,12 @@ struct ModelFlags {
     /// it), nearest entry first within leaves and within interior nodes, a tie to the later
     /// child (bvh-wide's `any_order=leaves`); false: as a closest-hit query orders them.
     bool any_leaves_first = false;
+    /// A child whose region a stretch of the ray (not a single point) only touches -- the ray
+    /// passing exactly through an edge or corner of its cell -- is entered: a grid's 3DDDA passes
+    /// a corner one axis at a time. False: the traversal crosses an edge or corner in one step and
+    /// enters only the cells the ray runs through (octrees and BSP trees; a camera ray through
+    /// the scene's centre meets their central edges).
+    bool point_touches = true;
 };
 
 /// A hierarchy flattened for the model: `nodes[0]` is the root; the children of a node are

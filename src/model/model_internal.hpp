@@ -112,6 +112,14 @@ struct Walk {
 
 /// Whether a hit found ends (part of) the search: an any-hit query stops at its first hit; a
 /// closest-hit one skips what lies beyond, unless the traversal visits everything (ModelFlags::cull).
+/// Whether the traversal enters a child whose clipped segment is `x`, its parent's being `s`:
+/// when `x` is not empty, except a single point of a longer `s` in a tree whose traversal steps
+/// over edges and corners (ModelFlags::point_touches false).
+inline bool meets(const ModelFlags& f, const Segment& s, const Segment& x) {
+    if (x.empty()) return false;
+    return f.point_touches || x.t0 < x.t1 || !(s.t0 < s.t1);
+}
+
 inline bool terminates(const ModelFlags& f, Query q) { return q == Query::Any || (q == Query::Closest && f.cull); }
 
 /// Sorts the children a segment meets, (entry t, child index) with the child at `t.nodes[base +

@@ -171,10 +171,12 @@ private:
     bool done() const { return any_ && found_; }
     // A closest-hit traversal skips a segment that starts at or beyond the nearest hit so far.
     bool beyond(const Segment& s) const { return cull_ && s.t0 >= hit_.t; }
-    // A child's segment, cut at the nearest hit so far when the traversal culls by it.
+    // A child's segment, cut at the nearest hit so far when the traversal culls by it; empty
+    // where the traversal does not enter it (model::meets).
     Segment child(std::uint32_t c, const Segment& s) const {
         Segment x = clip_segment(ri_, t_.nodes[c].region, s);
         if (cull_ && hit_.t < x.t1) x.t1 = hit_.t;
+        if (!meets(t_, s, x)) x = Segment{kInf, -kInf};
         return x;
     }
 

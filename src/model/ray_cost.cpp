@@ -64,7 +64,7 @@ struct RayCostModel::Impl {
         std::size_t nm = 0;
         for (std::uint32_t k = 0; k < m.count && nm < met.size(); ++k) {
             const Segment sc = clip_segment(ri, tree.nodes[m.first + k].region, s);
-            if (sc.empty()) continue;
+            if (!meets(tree, s, sc)) continue;
             segs[k] = sc;
             met[nm++] = {sc.t0, k};
         }

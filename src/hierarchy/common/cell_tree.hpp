@@ -92,8 +92,16 @@ public:
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        if (o_.locate) return o_.mailbox ? locate<C, Q, true>(ray, hit, counting) : locate<C, Q, false>(ray, hit, counting);
-        return o_.mailbox ? recursive<C, Q, true>(ray, hit, counting) : recursive<C, Q, false>(ray, hit, counting);
+        return trace_with<C, Q>(ray, hit, counting, RealPrimTest{*this->scene_});
+    }
+
+    /// The traversal with the primitive test supplied by the caller (design/replay.hpp).
+    template <class C, Query Q, class PrimTest>
+    bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {
+        if (o_.locate)
+            return o_.mailbox ? locate<C, Q, true>(ray, hit, counting, test) : locate<C, Q, false>(ray, hit, counting, test);
+        return o_.mailbox ? recursive<C, Q, true>(ray, hit, counting, test)
+                          : recursive<C, Q, false>(ray, hit, counting, test);
     }
 
 protected:
@@ -123,18 +131,24 @@ private:
     void make_leaf(std::uint32_t node, const std::vector<std::uint32_t>& refs);
     void build(std::uint32_t node, const Box3& cell, int depth, std::vector<std::uint32_t>& refs, const Assigner& as);
 
-    template <class C, Query Q, bool kMailbox>
-    bool test_leaf(const Node& n, int depth, const Ray& ray, Hit& hit, C& counting, spatial::Mailbox* mb,
-                   bool& found) const {
-        return subdiv::test_leaf<C, Q, kMailbox>(*this->scene_, refs_.data() + n.index, n.count, depth, ray, hit,
-                                                 counting, mb, found);
+    template <class C, Query Q, bool kMailbox, class PrimTest>
+    bool test_leaf(const Node& n, int depth, const Ray& ray, Hit& hit, C& counting, spatial::Mailbox* mb, bool& found,
+                   PrimTest& test) const {
+        // A replay's test is told when it enters a cell left unbuilt (a real trace never runs
+        // on a partial tree, and its test has no such member: no code here).
+        if constexpr (requires { test.unbuilt(); }) {
+            const auto i = static_cast<std::size_t>(&n - nodes_.data());
+            if (i < unbuilt_.size() && unbuilt_[i]) test.unbuilt();
+        }
+        return subdiv::test_leaf<C, Q, kMailbox>(refs_.data() + n.index, n.count, depth, ray, hit, counting, mb, found,
+                                                 test);
     }
 
     // From the root clip's entry t, descend to every leaf holding the ray just after t (one,
     // unless the ray lies in a split plane); test them; stop when the closest hit lies at or
     // before the smallest of their exits, otherwise descend again from the root at that exit.
-    template <class C, Query Q, bool kMailbox>
-    bool locate(const Ray& ray, Hit& hit, C& counting) const {
+    template <class C, Query Q, bool kMailbox, class PrimTest>
+    bool locate(const Ray& ray, Hit& hit, C& counting, PrimTest& test) const {
         counting.box();
         const CellRay r(ray);
         float t, t_end;
@@ -158,7 +172,7 @@ private:
                 const Item it = stack[--sp];
                 const Node& n = nodes[it.node];
                 if (n.leaf()) {
-                    if (test_leaf<C, Q, kMailbox>(n, it.depth, ray, hit, counting, mb, found)) return true;
+                    if (test_leaf<C, Q, kMailbox>(n, it.depth, ray, hit, counting, mb, found, test)) return true;
                     exit = it.up < exit ? it.up : exit;
                     continue;
                 }
@@ -178,8 +192,8 @@ private:
 
     // Front to back with an explicit stack over each node's stretch of the ray. A leaf ends the
     // search when the closest hit lies at t <= its t1 (unless beside a plane the ray lies in).
-    template <class C, Query Q, bool kMailbox>
-    bool recursive(const Ray& ray, Hit& hit, C& counting) const {
+    template <class C, Query Q, bool kMailbox, class PrimTest>
+    bool recursive(const Ray& ray, Hit& hit, C& counting, PrimTest& test) const {
         counting.box();
         const CellRay r(ray);
         CellEntry e{0, 0, 0, 0, true};
@@ -193,7 +207,7 @@ private:
         for (;;) {
             const Node& n = nodes[e.node];
             if (n.leaf()) {
-                if (test_leaf<C, Q, kMailbox>(n, e.depth, ray, hit, counting, mb, found)) return true;
+                if (test_leaf<C, Q, kMailbox>(n, e.depth, ray, hit, counting, mb, found, test)) return true;
                 if constexpr (Q != Query::All) {
                     if (e.may_end && hit.t <= e.t1) return found;
                 }
@@ -271,6 +285,7 @@ bool CellTree<Derived, NodeT>::emit_model(ModelSink& sink) const {
     // The paper's Kaplan/Glassner term: a plane compare and the far region's entry.
     ModelFlags f(Derived::kModelFamily, {.interior_plane = 1, .far_entry = true});
     f.locate = o_.locate;
+    f.point_touches = false;  // locate and the recursive children step over an edge or corner at once
     f.per_ray_box = 1;
     if (!sink.begin(f) || nodes_.empty()) return true;
     auto emit = [&](auto&& recurse, std::uint32_t i, const Box3& region) -> void {

@@ -66,4 +66,15 @@ inline bool test_prim(const Scene& scene, std::uint32_t id, const Ray& ray, Hit&
     return false;
 }
 
+/// The primitive test of a real trace (test_prim), for traversals that take the test as a
+/// parameter (`trace_with`): a design replays its sample through them with a test that answers
+/// from the rays' known crossings instead (design/replay.hpp).
+struct RealPrimTest {
+    const Scene& scene;
+    template <class C>
+    bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, C& counting) const {
+        return test_prim(scene, id, ray, hit, counting);
+    }
+};
+
 }  // namespace rtcost

@@ -121,18 +121,18 @@ private:
     std::vector<Box3> bounds_;
 };
 
-/// Tests the `count` references `refs` of a leaf at `depth` (bsp and octree leaves alike); true
-/// when an any-hit query may stop. With kMailbox, a primitive already tested in this ray is skipped.
-template <class C, Query Q, bool kMailbox>
-bool test_leaf(const Scene& s, const std::uint32_t* refs, std::uint32_t count, int depth, const Ray& ray, Hit& hit,
-               C& counting, spatial::Mailbox* mb, bool& found) {
+/// Tests the `count` references `refs` of a leaf at `depth` (bsp and octree leaves alike) with
+/// `test` (RealPrimTest, or a replay's); true when an any-hit query may stop. With kMailbox, a primitive already tested in this ray is skipped.
+template <class C, Query Q, bool kMailbox, class PrimTest>
+bool test_leaf(const std::uint32_t* refs, std::uint32_t count, int depth, const Ray& ray, Hit& hit, C& counting,
+               spatial::Mailbox* mb, bool& found, PrimTest& test) {
     counting.leaf(depth, count);
     for (std::uint32_t k = 0; k < count; ++k) {
         const std::uint32_t id = refs[k];
         if constexpr (kMailbox) {
             if (!mb->first_visit(id)) continue;
         }
-        if (test_prim(s, id, ray, hit, counting)) {
+        if (test(id, ray, hit, counting)) {
             found = true;
             if constexpr (Q == Query::Any) return true;
         }

@@ -7,62 +7,15 @@
 #include <cmath>
 #include <map>
 
+#include "design/replay.hpp"
+
 namespace rtcost::grid {
-
-SampleReplay::SampleReplay(const Scene& s, const RaySample& sample, const UnitCosts& costs)
-    : sample_(sample), costs_(costs), kinds_(s.size()) {
-    // One byte per primitive: the scene's records are far larger, and a replay looks a kind up
-    // for every reference of every cell it visits.
-    for (std::uint32_t id = 0; id < s.size(); ++id) kinds_[id] = static_cast<std::uint8_t>(s.kind(id));
-}
-
-double SampleReplay::cost(const Grid& g) const {
-    RayCounters counters;
-    Count counting{counters};
-    for (std::size_t i = 0; i < sample_.size(); ++i) {
-        const Query q = sample_.queries[i];
-        // A closest-hit query's crossings are nearest first; only the nearest one matters: a
-        // grid is left after the cell whose exit reaches the nearest hit, and that cell holds
-        // the nearest crossing's primitive (it holds the crossing point), whichever farther
-        // crossings were found before it.
-        const std::span<const Crossing> all = sample_.crossings_of(i);
-        const std::span<const Crossing> known = q == Query::Closest ? all.first(std::min<std::size_t>(all.size(), 1)) : all;
-        // The segments estimator's answer to a primitive test (model/probe.cpp's oracle): a
-        // known crossing nearer than the hit so far and before tmax.
-        auto test = [&](std::uint32_t id, const Ray& ray, Hit& hit, Count& c) {
-            c.prim(static_cast<PrimKind>(kinds_[id]));
-            for (const Crossing& x : known)
-                if (x.prim == id) {
-                    if (x.t < hit.t && x.t < ray.tmax) {
-                        hit.t = x.t;
-                        hit.prim = static_cast<std::int32_t>(id);
-                        return true;
-                    }
-                    return false;
-                }
-            return false;
-        };
-        const Ray& ray = sample_.rays.rays[i];
-        Hit hit;
-        switch (q) {
-            case Query::Closest: g.trace_with<Count, Query::Closest>(ray, hit, counting, test); break;
-            case Query::Any: g.trace_with<Count, Query::Any>(ray, hit, counting, test); break;
-            case Query::All: g.trace_with<Count, Query::All>(ray, hit, counting, test); break;
-        }
-    }
-    counters.rays = sample_.size();
-    return costs_.scalar(measured_cost(counters));
-}
-
-double replay_cost(const Grid& g, const Scene& s, const RaySample& sample, const UnitCosts& costs) {
-    return SampleReplay(s, sample, costs).cost(g);
-}
 
 std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, spatial::Assign assign, bool mailbox,
                                          std::uint64_t max_cells) {
     std::map<std::array<int, 3>, double> seen;
     const Box3 box = s.bounds();
-    const SampleReplay replay(s, in.sample, in.costs);
+    const designing::SampleReplay replay(s, in.sample, in.costs);
     auto cost = [&](std::array<int, 3> r) -> double {
         for (int a = 0; a < 3; ++a) r[a] = std::clamp(r[a], 1, kMaxRes);
         if (auto it = seen.find(r); it != seen.end()) return it->second;

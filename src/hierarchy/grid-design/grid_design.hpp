@@ -18,27 +18,6 @@ struct Candidate {
     double cost = 0;
 };
 
-/// The cost per ray that the model (segments estimator) predicts for a grid on a ray sample,
-/// found by the grid's own traversal of each sample ray with its known crossings in place of
-/// primitive tests: the model tree's replay visits the same cells (a cell is entered while its
-/// entry lies before the nearest known hit), so without mailboxes this is sample_cost(grid,
-/// ...), at the cost of the cells the rays visit instead of a model tree of two nodes per cell.
-/// With mailboxes it counts only a primitive's first test, as the traversal does (the model
-/// tree does not know mailboxes). One per search: it holds the scene's primitive kinds.
-class SampleReplay {
-public:
-    SampleReplay(const Scene& s, const RaySample& sample, const UnitCosts& costs);
-    double cost(const Grid& g) const;
-
-private:
-    const RaySample& sample_;
-    UnitCosts costs_;
-    std::vector<std::uint8_t> kinds_;
-};
-
-/// SampleReplay(s, sample, costs).cost(g).
-double replay_cost(const Grid& g, const Scene& s, const RaySample& sample, const UnitCosts& costs);
-
 /// The search: the hetero formula's cell shape from 1 cell per primitive, doubled (up to 64) or
 /// else halved (down to 1/8) while the cost falls, then
 /// coordinate descent on each axis (factors 3/4 and 4/3) from the cheapest, until no step

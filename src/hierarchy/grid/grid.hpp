@@ -60,15 +60,12 @@ public:
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        return trace_with<C, Q>(ray, hit, counting, [this](std::uint32_t id, const Ray& r, Hit& h, C& c) {
-            return test_prim(*scene_, id, r, h, c);
-        });
+        return trace_with<C, Q>(ray, hit, counting, RealPrimTest{*scene_});
     }
 
     /// The traversal with the primitive test supplied by the caller: `test(id, ray, hit,
     /// counting)` counts its test, records a hit nearer than `hit.t` and says whether it found
-    /// one. grid-design replays a ray sample this way, answering from the rays' known crossings
-    /// instead of intersecting: a candidate grid's cost on the sample without its model tree.
+    /// one (design/replay.hpp).
     template <class C, Query Q, class PrimTest>
     bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest&& test) const {
         return mailbox_ ? walk<C, Q, true>(ray, hit, counting, test) : walk<C, Q, false>(ray, hit, counting, test);

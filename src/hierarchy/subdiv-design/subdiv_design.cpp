@@ -6,6 +6,7 @@
 #include "../bsp/bsp.hpp"
 #include "../octree/octree.hpp"
 #include "design/cell_rays.hpp"
+#include "design/replay.hpp"
 #include "design/sample_reach.hpp"
 #include "model/model_internal.hpp"
 
@@ -39,19 +40,22 @@ std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, double planes,
         return cells.split_pays(cell, n, children, counts, k);
     };
     auto designed = std::make_unique<H>(s, o);
-    const double designed_cost = sample_cost(*designed, s, in.sample, in.costs);
+    // Each tree priced by its own traversal of the sample (design/replay.hpp: the model's
+    // prediction without materialising its model tree, most of the design's time before).
+    const designing::SampleReplay replay(s, in.sample, in.costs);
+    const double designed_cost = replay.cost(*designed);
     designing::SampleReach reach(in.sample, s.bounds());
     subdiv::CellOptions reached = usual;
     reached.reached = [&reach](const Box3& cell, int depth) { return reach(cell, depth); };
     std::unique_ptr<H> yardstick = std::make_unique<H>(s, reached);
     double yardstick_cost;
     try {
-        yardstick_cost = sample_cost(*yardstick, s, in.sample, in.costs);
+        yardstick_cost = replay.cost(*yardstick);
     } catch (const model::PrunedNodeReached&) {
-        // A replay went where no segment was thought to reach (it cannot, but rounding is
+        // A ray went where no segment was thought to reach (it cannot, but rounding is
         // rounding): the whole tree.
         yardstick = std::make_unique<H>(s, usual);
-        yardstick_cost = sample_cost(*yardstick, s, in.sample, in.costs);
+        yardstick_cost = replay.cost(*yardstick);
     }
     if (!(yardstick_cost < designed_cost)) return designed;
     if (yardstick->partial()) yardstick = std::make_unique<H>(s, usual);

@@ -1,0 +1,80 @@
+#pragma once
+// A design's price of a built candidate on its sample, by the candidate's own traversal: each
+// sample ray traced with a primitive test that answers from the ray's known crossings (what the
+// segments estimator's probe does through a model tree), the operations counted and priced.
+// Without mailboxes this is the model's prediction (sample_cost) -- the model tree's replay
+// visits what the traversal visits -- at the cost of the nodes the rays reach, with no model
+// tree materialised (a grid's holds two nodes per cell; a designed octree's, 10^5 nodes, was
+// most of its design time). With mailboxes it counts only a primitive's first test per ray, as
+// the traversal does (the model tree does not know mailboxes).
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include "../model/model_internal.hpp"
+#include "rtcost/design.hpp"
+#include "rtcost/stats.hpp"
+
+namespace rtcost::designing {
+
+/// The sample's cost per ray through any hierarchy `H` with
+///   template <class C, Query Q, class PrimTest> bool trace_with(const Ray&, Hit&, C&, PrimTest) const;
+/// One per design: it holds the scene's primitive kinds, one byte each. On a cell tree built
+/// only where the sample reaches, throws model::PrunedNodeReached if a ray enters a cell left
+/// unbuilt.
+class SampleReplay {
+public:
+    SampleReplay(const Scene& s, const RaySample& sample, const UnitCosts& costs)
+        : sample_(sample), costs_(costs), kinds_(s.size()) {
+        // The scene's records are far larger, and a replay looks up a kind for every reference
+        // of every leaf it visits.
+        for (std::uint32_t id = 0; id < s.size(); ++id) kinds_[id] = static_cast<std::uint8_t>(s.kind(id));
+    }
+
+    template <class H>
+    double cost(const H& h) const {
+        RayCounters counters;
+        Count counting{counters};
+        for (std::size_t i = 0; i < sample_.size(); ++i) {
+            const std::span<const Crossing> known = sample_.crossings_of(i);
+            const KnownTest test{known, kinds_};
+            const Ray& ray = sample_.rays.rays[i];
+            Hit hit;
+            switch (sample_.queries[i]) {
+                case Query::Closest: h.template trace_with<Count, Query::Closest>(ray, hit, counting, test); break;
+                case Query::Any: h.template trace_with<Count, Query::Any>(ray, hit, counting, test); break;
+                case Query::All: h.template trace_with<Count, Query::All>(ray, hit, counting, test); break;
+            }
+        }
+        counters.rays = sample_.size();
+        return costs_.scalar(measured_cost(counters));
+    }
+
+private:
+    // The segments estimator's answer to a primitive test (model/probe.cpp's oracle): a known
+    // crossing nearer than the hit so far and before tmax.
+    struct KnownTest {
+        std::span<const Crossing> known;
+        const std::vector<std::uint8_t>& kinds;
+        bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, Count& c) const {
+            c.prim(static_cast<PrimKind>(kinds[id]));
+            for (const Crossing& x : known)
+                if (x.prim == id) {
+                    if (!(x.t < hit.t && x.t < ray.tmax)) return false;
+                    hit.t = x.t;
+                    hit.prim = static_cast<std::int32_t>(id);
+                    return true;
+                }
+            return false;
+        }
+        /// A traversal of a tree built only where the sample reaches (subdiv::CellOptions::
+        /// reached) entered a cell left unbuilt: its price would be wrong.
+        [[noreturn]] void unbuilt() const { throw model::PrunedNodeReached{}; }
+    };
+
+    const RaySample& sample_;
+    UnitCosts costs_;
+    std::vector<std::uint8_t> kinds_;
+};
+
+}  // namespace rtcost::designing
