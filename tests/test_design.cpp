@@ -6,7 +6,6 @@
 #include "../src/design/sample_reach.hpp"
 #include "../src/hierarchy/bsp/bsp.hpp"
 #include "../src/design/replay.hpp"
-#include "../src/hierarchy/grid-design/grid_design.hpp"
 #include "../src/hierarchy/octree/octree.hpp"
 #include "rtcost/design.hpp"
 #include "rtcost/evaluate.hpp"
@@ -160,82 +159,6 @@ TEST(Design, GridDesignIsNoWorseOnItsSampleThanTheFormula) {
         // hetero at density 1 is the search's first candidate: the choice can only be cheaper.
         EXPECT_LE(cd, ch) << scene;
     }
-}
-
-// grid-design prices each candidate by replaying the sample through the grid's own traversal
-// (known crossings for primitive tests) instead of through its model tree: the same number.
-TEST(Design, GridReplayOfTheSampleIsTheModelTreesPrediction) {
-    int compared = 0, fewer_with_mailboxes = 0;
-    for (const char* scene : {"builtin:balls:2", "builtin:tetra:3", "gears"}) {
-        const std::string spec = spec_of(scene);
-        if (spec.rfind("builtin:", 0) != 0 && !std::filesystem::exists(spec)) continue;
-        const Scene s = load_scene(spec);
-        for (const char* rays : {"rays=camera", "rays=shadow", "rays=ao", "rays=spd"}) {
-            Params p(design_param_specs(), {rays, "size=48x48", "sample=600"});
-            const DesignInput in = draw_design_input(s, p);
-            const std::array<int, 3> hetero = grid::resolution("hetero", 4, s.size(), s.bounds());
-            for (const std::array<int, 3> res : {std::array{1, 1, 1}, std::array{7, 3, 11}, hetero}) {
-                for (spatial::Assign assign : {spatial::Assign::Bounds, spatial::Assign::Exact}) {
-                    const grid::Grid g(s, res, assign, false);
-                    const std::string what = std::string(scene) + " " + rays + " " + std::to_string(res[0]) + "x" +
-                                             std::to_string(res[1]) + "x" + std::to_string(res[2]);
-                    for (const UnitCosts& costs : {UnitCosts{}, UnitCosts::typical()}) {
-                        const double tree = sample_cost(g, s, in.sample, costs);
-                        // The recursion keeps its probabilities in floats: equal to ~1e-7.
-                        EXPECT_NEAR(designing::SampleReplay(s, in.sample, costs).cost(g), tree, 1e-6 * tree) << what;
-                        EXPECT_GT(tree, 1.0) << what;
-                    }
-                    // With mailboxes the traversal tests a primitive once per ray: never more.
-                    const grid::Grid mailboxed(s, res, assign, true);
-                    const double once = designing::SampleReplay(s, in.sample, UnitCosts{}).cost(mailboxed);
-                    const double tree = sample_cost(g, s, in.sample, UnitCosts{});
-                    EXPECT_LE(once, tree * (1 + 1e-6)) << what;
-                    fewer_with_mailboxes += once < 0.99 * tree;
-                    ++compared;
-                }
-            }
-        }
-    }
-    EXPECT_GE(compared, 48);
-    EXPECT_GT(fewer_with_mailboxes, 4);  // finer grids reference a primitive from several cells
-}
-
-// The octree and BSP designs price their designed tree the same way, through either traversal.
-TEST(Design, CellTreeReplayOfTheSampleIsTheModelTreesPrediction) {
-    int compared = 0;
-    for (const char* scene : {"builtin:balls:2", "builtin:tetra:4", "gears"}) {
-        const std::string spec = spec_of(scene);
-        if (spec.rfind("builtin:", 0) != 0 && !std::filesystem::exists(spec)) continue;
-        const Scene s = load_scene(spec);
-        for (const char* rays : {"rays=camera", "rays=shadow", "rays=diffuse", "rays=spd"}) {
-            Params p(design_param_specs(), {rays, "size=48x48", "sample=600"});
-            const DesignInput in = draw_design_input(s, p);
-            const designing::SampleReplay replay(s, in.sample, in.costs), by_count(s, in.sample, UnitCosts{});
-            for (bool locate : {true, false}) {
-                for (spatial::Assign assign : {spatial::Assign::Bounds, spatial::Assign::Exact}) {
-                    auto check = [&](const auto& h) {
-                        const std::string what = std::string(scene) + " " + rays + " " + std::string(h.name()) +
-                                                 (locate ? " locate" : " recursive");
-                        const double tree = sample_cost(h, s, in.sample, in.costs);
-                        EXPECT_NEAR(replay.cost(h), tree, 1e-6 * tree) << what;
-                        const double ops = sample_cost(h, s, in.sample, UnitCosts{});
-                        EXPECT_NEAR(by_count.cost(h), ops, 1e-6 * ops) << what;
-                        EXPECT_GT(ops, 2.0) << what;
-                        ++compared;
-                    };
-                    subdiv::CellOptions o;
-                    o.locate = locate;
-                    o.assign = assign;
-                    o.max_depth = 6;
-                    o.max_prims = 2;
-                    check(octree::Octree(s, o));
-                    o.max_depth = 16;
-                    check(bsp::Bsp(s, o));
-                }
-            }
-        }
-    }
-    EXPECT_GE(compared, 64);
 }
 
 TEST(Design, KdDesignKeepsTheEmptyBonusTheModelPredictsCheaper) {

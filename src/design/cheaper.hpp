@@ -7,28 +7,24 @@
 #include <memory>
 #include <vector>
 
+#include "replay.hpp"
 #include "rtcost/design.hpp"
 
 namespace rtcost::designing {
 
-/// Of `trees`, the one the model predicts cheapest on the design sample; a tie keeps the earlier.
-inline std::unique_ptr<Hierarchy> cheapest_on_sample(std::vector<std::unique_ptr<Hierarchy>> trees, const Scene& s,
-                                                     const DesignInput& in) {
+/// Of `trees`, the one predicted cheapest on the design sample, each priced by its own traversal
+/// of the sample (replay.hpp); a tie keeps the earlier.
+template <class H>
+std::unique_ptr<Hierarchy> cheapest_on_sample(std::vector<std::unique_ptr<H>> trees, const Scene& s,
+                                              const DesignInput& in) {
+    const SampleReplay replay(s, in.sample, in.costs);
     std::size_t best = 0;
     double best_cost = kInf;
     for (std::size_t i = 0; i < trees.size(); ++i) {
-        const double c = sample_cost(*trees[i], s, in.sample, in.costs);
+        const double c = replay.cost(*trees[i]);
         if (c < best_cost) best = i, best_cost = c;
     }
     return std::move(trees[best]);
-}
-
-inline std::unique_ptr<Hierarchy> cheaper_on_sample(std::unique_ptr<Hierarchy> designed, std::unique_ptr<Hierarchy> usual,
-                                                    const Scene& s, const DesignInput& in) {
-    std::vector<std::unique_ptr<Hierarchy>> trees;
-    trees.push_back(std::move(designed));
-    trees.push_back(std::move(usual));
-    return cheapest_on_sample(std::move(trees), s, in);
 }
 
 }  // namespace rtcost::designing

@@ -11,6 +11,7 @@
 #include <map>
 
 #include "../bvh/topdown.hpp"
+#include "design/replay.hpp"
 #include "occlusion_order.hpp"
 #include "rtcost/design.hpp"
 
@@ -271,11 +272,14 @@ const Registration reg{
                  bool leaves;
                  double cost;
              } best{nullptr, false, 0};
+             // Each priced by its own traversal of the sample (design/replay.hpp): the model's
+             // prediction without materialising the trees' model trees.
+             const designing::SampleReplay replay(s, in.sample, in.costs);
              for (Bvh* h : {designed.get(), by_sah.get()}) {  // a tie keeps the designed splits
                  for (bool leaves : {false, true}) {
                      if (!(leaves ? try_leaves : try_near)) continue;
                      h->set_any_leaves_first(leaves);
-                     const double c = sample_cost(*h, s, in.sample, in.costs);
+                     const double c = replay.cost(*h);
                      if (!best.h || c < best.cost) best = {h, leaves, c};
                  }
              }

@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "../common/impl.hpp"
@@ -75,17 +76,24 @@ public:
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
+        return trace_with<C, Q>(ray, hit, counting, RealPrimTest{*scene_});
+    }
+
+    /// The traversal with the primitive test supplied by the caller (design/replay.hpp); with
+    /// RealPrimTest, the leaves' own test of their triangle copies.
+    template <class C, Query Q, class PrimTest>
+    bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {
         // Query::All never cuts by a hit found, which is the unordered walk.
-        if constexpr (Q == Query::All) return walk<C, Q, false>(ray, hit, counting);
-        else return ordered_ ? walk<C, Q, true>(ray, hit, counting) : walk<C, Q, false>(ray, hit, counting);
+        if constexpr (Q == Query::All) return walk<C, Q, false>(ray, hit, counting, test);
+        else return ordered_ ? walk<C, Q, true>(ray, hit, counting, test) : walk<C, Q, false>(ray, hit, counting, test);
     }
 
 protected:
     StructureStats compute_structure() const override;
 
 private:
-    template <class C, Query Q, bool kOrdered>
-    bool walk(const Ray& ray, Hit& hit, C& counting) const {
+    template <class C, Query Q, bool kOrdered, class PrimTest>
+    bool walk(const Ray& ray, Hit& hit, C& counting, PrimTest& test) const {
         struct Entry {
             std::uint32_t node;
             float t;
@@ -114,7 +122,7 @@ private:
                 const Node& n = nodes[e.node];
                 if (n.leaf) {
                     counting.leaf(e.depth, n.count);
-                    if (test_leaf<C, Q>(n.index, n.count, ray, shear, hit, counting, found)) return true;
+                    if (test_leaf<C, Q>(n.index, n.count, ray, shear, hit, counting, found, test)) return true;
                     goto pop;
                 }
                 counting.interior(e.depth);
@@ -181,11 +189,14 @@ private:
     }
 
     /// Tests the leaf's `count` primitives from prims_[first]; true when an any-hit query ends.
-    template <class C, Query Q>
+    template <class C, Query Q, class PrimTest>
     bool test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, const RayShear& shear, Hit& hit, C& counting,
-                   bool& found) const {
+                   bool& found, PrimTest& test) const {
         for (const LeafPrim* p = prims_.data() + first; p != prims_.data() + first + count; ++p) {
-            if (test_prim(*scene_, *p, ray, shear, hit, counting)) {
+            bool met;
+            if constexpr (std::is_same_v<PrimTest, RealPrimTest>) met = test_prim(*scene_, *p, ray, shear, hit, counting);
+            else met = test(p->id, ray, hit, counting);
+            if (met) {
                 found = true;
                 if constexpr (Q == Query::Any) return true;
             }

@@ -57,7 +57,7 @@ const Registration reg{
          const SahOptions usual_sah;  // kd-sah's defaults
          std::vector<float> bonuses = {usual_sah.empty_bonus, 0.0f};
          if (!p.is("empty_bonus", "auto")) bonuses = {static_cast<float>(p.real("empty_bonus"))};
-         std::vector<std::unique_ptr<Hierarchy>> trees;  // a tie keeps the earlier: kd-sah's bonus first
+         std::vector<std::unique_ptr<KdTree>> trees;  // a tie keeps the earlier: kd-sah's bonus first
          for (float bonus : bonuses) {
              // An interior visit of kd-sah's traversal: a step and one plane.
              Designer d{{}, designing::CellRays(s, in, p.real("trust"), in.costs.step + in.costs.plane)};

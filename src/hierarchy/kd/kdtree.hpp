@@ -142,16 +142,25 @@ public:
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        if (boxes_) return mailbox_ ? walk<C, Q, true, true>(ray, hit, counting) : walk<C, Q, true, false>(ray, hit, counting);
-        return mailbox_ ? walk<C, Q, false, true>(ray, hit, counting) : walk<C, Q, false, false>(ray, hit, counting);
+        return trace_with<C, Q>(ray, hit, counting, RealPrimTest{*scene_});
+    }
+
+    /// The traversal with the primitive test supplied by the caller (design/replay.hpp).
+    template <class C, Query Q, class PrimTest>
+    bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {
+        if (boxes_)
+            return mailbox_ ? walk<C, Q, true, true>(ray, hit, counting, test)
+                            : walk<C, Q, true, false>(ray, hit, counting, test);
+        return mailbox_ ? walk<C, Q, false, true>(ray, hit, counting, test)
+                        : walk<C, Q, false, false>(ray, hit, counting, test);
     }
 
 protected:
     StructureStats compute_structure() const override;
 
 private:
-    template <class C, Query Q, bool kBoxes, bool kMailbox>
-    bool walk(const Ray& ray, Hit& hit, C& counting) const {
+    template <class C, Query Q, bool kBoxes, bool kMailbox, class PrimTest>
+    bool walk(const Ray& ray, Hit& hit, C& counting, PrimTest& test) const {
         struct Entry {
             std::uint32_t node;
             float t0, t1;
@@ -177,7 +186,7 @@ private:
                     if constexpr (kMailbox) {
                         if (!mb->first_visit(id)) continue;
                     }
-                    if (test_prim(*scene_, id, ray, hit, counting)) {
+                    if (test(id, ray, hit, counting)) {
                         found = true;
                         if constexpr (Q == Query::Any) return true;
                     }

@@ -23,7 +23,7 @@ std::vector<ParamSpec> specs(int default_depth, int max_depth, int default_prims
 // Builds with the model's split test (the test and the sample it reads live only during the
 // build) and compares it, on the sample, with the tree the builder makes with the yardstick's
 // depth and leaf size (`usual_depth`, `usual_prims`); keeps the one the model predicts cheaper
-// (a tie keeps the design, as designing::cheaper_on_sample does). The yardstick's tree is first
+// (a tie keeps the design, as designing::cheapest_on_sample does). The yardstick's tree is first
 // built only where the sample reaches (a yardstick octree can be a hundred times the design's
 // size, all of it built only to be compared), and whole only when it is kept.
 template <class H>
