@@ -134,79 +134,62 @@ Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool 
         inv_cell_[a] = ext > 0 ? static_cast<float>(r) / ext : 0.0f;
     }
 
-    // Each primitive's cell range: the first cell whose upper boundary reaches its box's lo, the
-    // last whose lower boundary is <= its hi (closed intervals: every cell the box overlaps).
-    auto cell_range = [&](const Box3& pb, int lo[3], int hi[3]) {
-        for (int a = 0; a < 3; ++a) {
-            const float* pl = planes_[a].data();
-            const int r = res_[a];
-            lo[a] = static_cast<int>(std::lower_bound(pl + 1, pl + r + 1, pb.lo[a]) - (pl + 1));
-            hi[a] = static_cast<int>(std::upper_bound(pl, pl + r, pb.hi[a]) - pl) - 1;
-            lo[a] = std::min(lo[a], r - 1);
-            hi[a] = std::max(hi[a], 0);
+    // Every cell each primitive's box overlaps (closed intervals), primitives in id order: from
+    // the first cell whose upper boundary reaches the box's lo to the last whose lower boundary
+    // is <= its hi.
+    auto each_overlap = [&](auto&& f) {
+        for (std::uint32_t id = 0; id < s.size(); ++id) {
+            const Box3 pb = s.prim_bounds(id);
+            if (pb.empty()) continue;
+            int lo[3], hi[3];
+            for (int a = 0; a < 3; ++a) {
+                const float* pl = planes_[a].data();
+                const int r = res_[a];
+                lo[a] = std::min(static_cast<int>(std::lower_bound(pl + 1, pl + r + 1, pb.lo[a]) - (pl + 1)), r - 1);
+                hi[a] = std::max(static_cast<int>(std::upper_bound(pl, pl + r, pb.hi[a]) - pl) - 1, 0);
+            }
+            for (int k = lo[2]; k <= hi[2]; ++k)
+                for (int j = lo[1]; j <= hi[1]; ++j)
+                    for (int i = lo[0]; i <= hi[0]; ++i) f(id, pb, i, j, k);
         }
     };
     const std::uint64_t cells = product(res_);
     offsets_.assign(cells + 1, 0);
     if (empty_) return;
-    auto too_many = [&](std::uint64_t n) {
-        if (n > std::numeric_limits<std::uint32_t>::max())
+    // Per-cell counts (offsets_[c + 1]) into CSR offsets, and room for `total` references.
+    auto to_offsets = [&](std::uint64_t total) {
+        if (total > std::numeric_limits<std::uint32_t>::max())
             throw InputError("--set", 0,
                              fmt::format("grid {}x{}x{} needs {} references, more than 2^32; choose a coarser resolution",
-                                         res_[0], res_[1], res_[2], n));
+                                         res_[0], res_[1], res_[2], total));
+        for (std::uint64_t c = 0; c < cells; ++c) offsets_[c + 1] += offsets_[c];
+        refs_.resize(total);
+        return std::vector<std::uint32_t>(offsets_.begin(), offsets_.end() - 1);  // each cell's next slot
     };
     if (assign == spatial::Assign::Bounds) {
-        // The ranges say every reference: count per cell, then fill, with no list of pairs (a
+        // The overlaps are every reference: count per cell, then fill, with no list of pairs (a
         // grid-design search builds a score of candidate grids, and the pairs' memory was most
         // of each build). Each cell's ids come out ascending.
         std::uint64_t total = 0;
-        for (std::uint32_t id = 0; id < s.size(); ++id) {
-            const Box3 pb = s.prim_bounds(id);
-            if (pb.empty()) continue;
-            int lo[3], hi[3];
-            cell_range(pb, lo, hi);
-            for (int k = lo[2]; k <= hi[2]; ++k)
-                for (int j = lo[1]; j <= hi[1]; ++j)
-                    for (int i = lo[0]; i <= hi[0]; ++i) ++offsets_[cell_index(i, j, k) + 1];
-            total += std::uint64_t(std::max(0, hi[0] - lo[0] + 1)) * std::max(0, hi[1] - lo[1] + 1) * std::max(0, hi[2] - lo[2] + 1);
-        }
-        too_many(total);
-        for (std::uint64_t c = 0; c < cells; ++c) offsets_[c + 1] += offsets_[c];
-        refs_.resize(total);
-        std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
-        for (std::uint32_t id = 0; id < s.size(); ++id) {
-            const Box3 pb = s.prim_bounds(id);
-            if (pb.empty()) continue;
-            int lo[3], hi[3];
-            cell_range(pb, lo, hi);
-            for (int k = lo[2]; k <= hi[2]; ++k)
-                for (int j = lo[1]; j <= hi[1]; ++j)
-                    for (int i = lo[0]; i <= hi[0]; ++i) refs_[fill[cell_index(i, j, k)]++] = id;
-        }
+        each_overlap([&](std::uint32_t, const Box3&, int i, int j, int k) {
+            ++offsets_[cell_index(i, j, k) + 1];
+            ++total;
+        });
+        std::vector<std::uint32_t> fill = to_offsets(total);
+        each_overlap([&](std::uint32_t id, const Box3&, int i, int j, int k) { refs_[fill[cell_index(i, j, k)]++] = id; });
         return;
     }
-    // Exact assignment: each overlap test once, the references kept as (cell, id) pairs in id
+    // Exact assignment: each surface test once, the references kept as (cell, id) pairs in id
     // order, then a counting sort into CSR (each cell's ids ascending).
     std::vector<std::uint64_t> pair_cell;
     std::vector<std::uint32_t> pair_id;
-    for (std::uint32_t id = 0; id < s.size(); ++id) {
-        const Box3 pb = s.prim_bounds(id);
-        if (pb.empty()) continue;
-        int lo[3], hi[3];
-        cell_range(pb, lo, hi);
-        for (int k = lo[2]; k <= hi[2]; ++k)
-            for (int j = lo[1]; j <= hi[1]; ++j)
-                for (int i = lo[0]; i <= hi[0]; ++i)
-                    if (spatial::overlaps(s, id, pb, cell_box(i, j, k), assign)) {
-                        pair_cell.push_back(cell_index(i, j, k));
-                        pair_id.push_back(id);
-                    }
-    }
-    too_many(pair_id.size());
+    each_overlap([&](std::uint32_t id, const Box3& pb, int i, int j, int k) {
+        if (!spatial::overlaps(s, id, pb, cell_box(i, j, k), assign)) return;
+        pair_cell.push_back(cell_index(i, j, k));
+        pair_id.push_back(id);
+    });
     for (std::uint64_t c : pair_cell) ++offsets_[c + 1];
-    for (std::uint64_t c = 0; c < cells; ++c) offsets_[c + 1] += offsets_[c];
-    refs_.resize(pair_id.size());
-    std::vector<std::uint32_t> fill(offsets_.begin(), offsets_.end() - 1);
+    std::vector<std::uint32_t> fill = to_offsets(pair_id.size());
     for (std::size_t p = 0; p < pair_id.size(); ++p) refs_[fill[pair_cell[p]]++] = pair_id[p];
 }
 
