@@ -172,11 +172,14 @@ private:
     // A closest-hit traversal skips a segment that starts at or beyond the nearest hit so far.
     bool beyond(const Segment& s) const { return cull_ && s.t0 >= hit_.t; }
     // A child's segment, cut at the nearest hit so far when the traversal culls by it; empty
-    // where the traversal does not enter it (model::meets).
+    // where the traversal does not enter it (model::meets), and where it starts at or beyond
+    // that hit: no traversal enters a region there (a BVH pops it, a subdivision has stopped at
+    // the cell before), and a region that begins in the hit's plane (gears' coplanar faces)
+    // is not entered either.
     Segment child(std::uint32_t c, const Segment& s) const {
         Segment x = clip_segment(ri_, t_.nodes[c].region, s);
         if (cull_ && hit_.t < x.t1) x.t1 = hit_.t;
-        if (!meets(t_, s, x)) x = Segment{kInf, -kInf};
+        if (!meets(t_, s, x) || beyond(x)) x = Segment{kInf, -kInf};
         return x;
     }
 
