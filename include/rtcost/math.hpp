@@ -104,7 +104,7 @@ struct RayInv {
 /// NaN in the second argument discard, so an axis-parallel ray inside the slab is accepted and one
 /// outside (both bounds of the same sign, +-inf) is rejected. The final bounds are multiplied by
 /// 1 + 2 gamma(3) (Ize 2013) so that a ray through an edge or a vertex is never lost to rounding.
-inline float box_entry(const Box3& b, const Vec3& o, const Vec3& inv, float tmin, float tmax) {
+[[gnu::always_inline]] inline float box_entry(const Box3& b, const Vec3& o, const Vec3& inv, float tmin, float tmax) {
     float t0 = tmin, t1 = tmax;
     for (int a = 0; a < 3; ++a) {
         // Entry and exit faces by the reciprocal's sign, not by comparing the two values: with
@@ -122,7 +122,10 @@ inline float box_entry(const Box3& b, const Vec3& o, const Vec3& inv, float tmin
 
 /// box_entry with the entry and exit faces chosen by the direction's signs (no compare and swap
 /// per axis): the same result, for traversals that test many boxes per ray.
-inline float box_entry(const Box3& b, const RayInv& r, float tmin, float tmax) {
+// Always inlined: called per child box in every traversal's inner loop, where a translation
+// unit with many traversal instances (a design's replays) had GCC stop inlining it (bvh-design's
+// closest-hit walk ran 30% slower).
+[[gnu::always_inline]] inline float box_entry(const Box3& b, const RayInv& r, float tmin, float tmax) {
     const Vec3* f = &b.lo;  // f[0] = lo, f[1] = hi
     float t0 = tmin, t1 = tmax;
     const float nx = (f[r.neg[0]].x - r.o.x) * r.inv.x, fx = (f[1 - r.neg[0]].x - r.o.x) * r.inv.x * 1.0000004f;
