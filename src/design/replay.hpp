@@ -51,21 +51,13 @@ public:
     }
 
 private:
-    // The segments estimator's answer to a primitive test (model/probe.cpp's oracle): a known
-    // crossing nearer than the hit so far and before tmax.
+    // The segments estimator's answer to a primitive test, counted.
     struct KnownTest {
         std::span<const Crossing> known;
         const std::vector<std::uint8_t>& kinds;
         bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, Count& c) const {
             c.prim(static_cast<PrimKind>(kinds[id]));
-            for (const Crossing& x : known)
-                if (x.prim == id) {
-                    if (!(x.t < hit.t && x.t < ray.tmax)) return false;
-                    hit.t = x.t;
-                    hit.prim = static_cast<std::int32_t>(id);
-                    return true;
-                }
-            return false;
+            return model::known_crossing_hit(known, id, ray, hit);
         }
         /// A traversal of a tree built only where the sample reaches (subdiv::CellOptions::
         /// reached) entered a cell left unbuilt: its price would be wrong.

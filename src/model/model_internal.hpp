@@ -92,6 +92,20 @@ std::vector<NodeProbabilities> segment_probabilities(const ModelTree& t, const S
 /// predicts on the whole tree).
 struct PrunedNodeReached {};
 
+/// The segments estimator's answer to a test of primitive `id` by a ray whose known crossings
+/// (nearest first) are `known`: a crossing nearer than the hit so far and before tmax is
+/// recorded in `hit`. The model's probe and the designs' replays (design/replay.hpp) share it.
+inline bool known_crossing_hit(std::span<const Crossing> known, std::uint32_t id, const Ray& ray, Hit& hit) {
+    for (const Crossing& x : known)
+        if (x.prim == id) {
+            if (!(x.t < hit.t && x.t < ray.tmax)) return false;
+            hit.t = x.t;
+            hit.prim = static_cast<std::int32_t>(id);
+            return true;
+        }
+    return false;
+}
+
 /// Each node's parent and traversal depth (the number of its ancestors that are steps), for the
 /// sampled estimator's recursion over a materialised tree.
 struct Walk {

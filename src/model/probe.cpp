@@ -37,18 +37,7 @@ public:
         if (!sample_) return test_prim(s_, id, ray, hit, nc_);
         // A ray's crossings are a few (at most kMaxCrossings): a scan beats a table over the
         // scene's primitives, which cost a pass over the scene per prediction.
-        float t = kInf;
-        for (const Crossing& c : known_)
-            if (c.prim == id) {
-                t = c.t;
-                break;
-            }
-        if (t < hit.t && t < ray.tmax) {
-            hit.t = t;
-            hit.prim = static_cast<std::int32_t>(id);
-            return true;
-        }
-        return false;
+        return known_crossing_hit(known_, id, ray, hit);
     }
 
 private:
