@@ -93,6 +93,12 @@ private:
     std::map<std::string, ParamSpec> specs_;
 };
 
+/// One primitive a ray meets in (tmin, tmax): its id and the nearest parameter there.
+struct Crossing {
+    std::uint32_t prim = 0;
+    float t = 0;
+};
+
 /// An acceleration structure over a scene. Thread-safe for concurrent queries.
 class Hierarchy {
 public:
@@ -113,6 +119,14 @@ public:
     /// segment meets is visited; `hit` receives the closest hit.
     virtual void all(const Ray& ray, Hit& hit) const = 0;
     virtual void all(const Ray& ray, Hit& hit, RayCounters& counters) const = 0;
+
+    /// The first primitives `ray` meets in (tmin, tmax), nearest first, each once at its nearest
+    /// parameter there (a closed surface met again on its way out counts once): at most
+    /// `out.size()` of them, written to `out`; returns how many. How a ray sample learns how its
+    /// rays end (sample.hpp). A hierarchy whose traversal takes its primitive test finds them
+    /// in one traversal and keeps every primitive met at the same parameter as another; the
+    /// others restart a closest-hit query at each crossing found, which keeps one of such ties.
+    virtual std::size_t crossings(const Ray& ray, std::span<Crossing> out) const;
 
     /// Structural statistics (N_IN, N_V, N_EV, N_OIV, depth, bytes, build seconds).
     StructureStats structure() const {

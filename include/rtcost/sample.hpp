@@ -15,12 +15,6 @@
 
 namespace rtcost {
 
-/// One primitive a sampled ray meets in (tmin, tmax): its id and the nearest parameter there.
-struct Crossing {
-    std::uint32_t prim = 0;
-    float t = 0;
-};
-
 /// The sample: rays with their kinds, the query each is traced with, where the search ends
 /// (`t_end`: the closest hit, the nearest occluder, or tmax when nothing is met), and the first
 /// primitives met along each ray (up to `kMaxCrossings`, nearest first, each once), which a
@@ -76,7 +70,8 @@ std::size_t sample_size(const RaySet& all, std::size_t count, std::uint64_t seed
 std::size_t draw_sample_count(const RaySet& all, std::size_t count);
 
 /// Finds how each of `s`'s rays ends (t_end and crossings, replacing any) with `reference`, an
-/// exact hierarchy over the scene, tracing with the rays' own tmin and tmax.
+/// exact hierarchy over the scene, tracing with the rays' own tmin and tmax: its first
+/// kMaxCrossings crossings (Hierarchy::crossings).
 void find_ends(RaySample& s, const Hierarchy& reference);
 
 /// A sample of the scene alone, for predictions without the user's rays (the geometric

@@ -46,6 +46,23 @@ bool Hierarchy::modelled() const {
     return emit_model(a);
 }
 
+std::size_t Hierarchy::crossings(const Ray& ray, std::span<Crossing> out) const {
+    std::size_t n = 0;
+    Ray r = ray;
+    // A primitive met twice (entry and exit of a sphere) costs an extra query, so allow some.
+    for (std::size_t step = 0; step < 2 * out.size() && n < out.size(); ++step) {
+        Hit hit;
+        closest(r, hit);
+        if (!hit.hit()) break;
+        const auto id = static_cast<std::uint32_t>(hit.prim);
+        if (std::none_of(out.begin(), out.begin() + n, [&](const Crossing& c) { return c.prim == id; }))
+            out[n++] = {id, hit.t};
+        if (!(hit.t > r.tmin)) break;  // no progress (cannot happen with the open interval)
+        r.tmin = hit.t;
+    }
+    return n;
+}
+
 ModelTree Hierarchy::model_tree() const {
     ModelTree t;
     ModelCollector c(t);

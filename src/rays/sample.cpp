@@ -51,21 +51,36 @@ public:
         while ((std::uint64_t{1} << xbits_) < width) ++xbits_;
         while ((std::uint64_t{1} << ybits_) < height) ++ybits_;
         bits_ = xbits_ + ybits_;
+        // The flips of the codes' first bits, which every code needs: hashed once here.
+        flips_.resize(std::size_t{2} << std::min(bits_, kTabledBits));
+        for (std::size_t above = 1; above < flips_.size(); ++above) flips_[above] = flip(above);
     }
     /// The next pixel (row x width + column); false once every pixel was given.
     bool next(std::uint32_t& pixel) {
         while (i_ <= last()) {
-            const std::uint64_t code = scramble(bits_ ? reverse(i_) >> (64 - bits_) : 0);
+            const std::uint64_t code = bits_ ? reverse(i_) >> (64 - bits_) : 0;
             ++i_;
-            std::uint64_t x = 0, y = 0;
+            // The scrambled code's bits, most significant first (each flipped or not by a hash
+            // of the original bits above it), dealt to x and y as they come. A code is given up
+            // as soon as its bits so far put the pixel outside the image: with an image side
+            // just above a power of two, three codes in four are, most known from a few bits.
+            std::uint64_t x = 0, y = 0, above = 1;  // the original bits above, after a leading 1
             int xb = xbits_, yb = ybits_;
-            for (int b = bits_ - 1; b >= 0; --b) {  // the code's bits, most significant first
+            bool inside = true;
+            for (int b = bits_ - 1; b >= 0 && inside; --b) {
                 const std::uint64_t bit = (code >> b) & 1;
+                const std::uint64_t out = bit ^ (above < flips_.size() ? flips_[above] : flip(above));
+                above = (above << 1) | bit;
                 // x takes a bit when it has more left than y, or as many (x first).
-                if (xb > 0 && (xb >= yb || yb == 0)) x |= bit << --xb;
-                else y |= bit << --yb;
+                if (xb > 0 && (xb >= yb || yb == 0)) {
+                    x |= out << --xb;
+                    inside = x < width_;
+                } else {
+                    y |= out << --yb;
+                    inside = y < height_;
+                }
             }
-            if (x < width_ && y < height_) {
+            if (inside) {
                 pixel = static_cast<std::uint32_t>(y * width_ + x);
                 return true;
             }
@@ -74,15 +89,9 @@ public:
     }
 
 private:
-    std::uint64_t scramble(std::uint64_t code) const {
-        std::uint64_t out = 0, above = 1;  // the original bits above, after a leading 1
-        for (int b = bits_ - 1; b >= 0; --b) {
-            const std::uint64_t bit = (code >> b) & 1;
-            out |= (bit ^ (mix64(seed_ ^ (above * 0x9E3779B97F4A7C15ull)) & 1)) << b;
-            above = (above << 1) | bit;
-        }
-        return out;
-    }
+    /// Whether the bit after the original bits `above` (after a leading 1) is flipped.
+    std::uint64_t flip(std::uint64_t above) const { return mix64(seed_ ^ (above * 0x9E3779B97F4A7C15ull)) & 1; }
+    static constexpr int kTabledBits = 12;
     std::uint64_t last() const { return bits_ >= 64 ? ~0ull : (std::uint64_t{1} << bits_) - 1; }
     static std::uint64_t reverse(std::uint64_t x) {
         x = ((x >> 1) & 0x5555555555555555ull) | ((x & 0x5555555555555555ull) << 1);
@@ -94,6 +103,35 @@ private:
     std::uint64_t seed_;
     int xbits_ = 0, ybits_ = 0, bits_ = 0;
     std::uint64_t i_ = 0;
+    std::vector<std::uint8_t> flips_;  ///< flip(above) for every `above` of the first kTabledBits bits
+};
+
+/// A set of an image's pixels, a bit each: its pixels in ascending order and each one's rank
+/// among them without a sort (a sample's pixel batches come in the scrambled PixelOrder).
+class PixelSet {
+public:
+    explicit PixelSet(std::size_t image_pixels) : words_((image_pixels + 63) / 64, 0) {}
+    void insert(std::uint32_t p) { words_[p >> 6] |= std::uint64_t{1} << (p & 63); }
+    /// The pixels, ascending; ranks are counted from here on.
+    std::vector<std::uint32_t> ascending() {
+        std::vector<std::uint32_t> out;
+        below_.resize(words_.size());
+        for (std::size_t w = 0; w < words_.size(); ++w) {
+            below_[w] = static_cast<std::uint32_t>(out.size());
+            for (std::uint64_t bits = words_[w]; bits; bits &= bits - 1)
+                out.push_back(static_cast<std::uint32_t>(w * 64 + std::countr_zero(bits)));
+        }
+        return out;
+    }
+    /// The index of member `p` in ascending().
+    std::size_t rank(std::uint32_t p) const {
+        const std::uint64_t lower = (std::uint64_t{1} << (p & 63)) - 1;
+        return below_[p >> 6] + static_cast<std::size_t>(std::popcount(words_[p >> 6] & lower));
+    }
+
+private:
+    std::vector<std::uint64_t> words_;
+    std::vector<std::uint32_t> below_;  ///< members in the words before each
 };
 
 /// A pixel-drawn sample takes the rays of about twice its size in pixels, so that it holds about
@@ -133,8 +171,9 @@ std::vector<std::uint32_t> sample_pixels(std::size_t image_pixels, std::size_t i
             rays += n[k];
         }
     }
-    std::sort(taken.begin(), taken.end());
-    return taken;
+    PixelSet set(image_pixels);
+    for (std::uint32_t p : taken) set.insert(p);
+    return set.ascending();
 }
 
 /// The rays of `all` (a camera-based distribution: RaySet::pixels) of the sample's pixels.
@@ -171,25 +210,6 @@ std::vector<std::size_t> sample_indices(const RaySet& all, std::size_t count, st
     std::vector<std::size_t> idx = pick(from.size(), count, seed);
     for (std::size_t& i : idx) i = from[i];
     return idx;
-}
-
-/// The first primitives `ray` meets, nearest first, each once (a closed surface is met again
-/// on its way out): closest-hit queries, each starting where the last hit was.
-std::vector<Crossing> crossings(const Hierarchy& h, const Ray& ray) {
-    std::vector<Crossing> out;
-    Ray r = ray;
-    // A primitive met twice (entry and exit of a sphere) costs an extra query, so allow some.
-    for (std::size_t step = 0; step < 2 * kMaxCrossings && out.size() < kMaxCrossings; ++step) {
-        Hit hit;
-        h.closest(r, hit);
-        if (!hit.hit()) break;
-        const auto id = static_cast<std::uint32_t>(hit.prim);
-        if (std::none_of(out.begin(), out.end(), [&](const Crossing& c) { return c.prim == id; }))
-            out.push_back({id, hit.t});
-        if (!(hit.t > r.tmin)) break;  // no progress (cannot happen with the open interval)
-        r.tmin = hit.t;
-    }
-    return out;
 }
 
 }  // namespace
@@ -234,7 +254,11 @@ RaySet rays_outside_sample(const RaySet& all, std::size_t count, std::uint64_t s
 void find_ends(RaySample& s, const Hierarchy& reference) {
     const std::size_t n = s.rays.rays.size();
     std::vector<std::vector<Crossing>> per(n);
-    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) { per[i] = crossings(reference, s.rays.rays[i]); });
+    tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {
+        Crossing found[kMaxCrossings];
+        const std::size_t k = reference.crossings(s.rays.rays[i], found);
+        if (k) per[i].assign(found, found + k);
+    });
     s.first.clear();
     s.t_end.clear();
     s.crossings.clear();
@@ -293,16 +317,21 @@ RaySample draw_sample(const Scene& scene, const RaySpec& spec, std::size_t count
     std::vector<RaySet> parts;
     const std::vector<std::uint32_t> taken =
         sample_pixels(all.image_pixels, all.image_width, count, seed, [&](const std::vector<std::uint32_t>& batch) {
-            std::vector<std::uint32_t> sorted = batch;
-            std::sort(sorted.begin(), sorted.end());
+            PixelSet set(all.image_pixels);
+            for (std::uint32_t p : batch) set.insert(p);
+            const std::vector<std::uint32_t> sorted = set.ascending();
             making.only_pixels = &sorted;
             parts.push_back(make_rays(scene, spec, making));
-            const std::vector<std::uint32_t>& got = parts.back().pixels;  // ascending
-            std::vector<std::size_t> n(batch.size());
-            for (std::size_t k = 0; k < batch.size(); ++k) {
-                const auto [lo, hi] = std::equal_range(got.begin(), got.end(), batch[k]);
-                n[k] = static_cast<std::size_t>(hi - lo);
+            // Rays per pixel of `sorted` (both ascending: one merge), then in the batch's order.
+            std::vector<std::size_t> in_sorted(sorted.size());
+            std::size_t at = 0;
+            for (std::uint32_t p : parts.back().pixels) {
+                while (at < sorted.size() && sorted[at] < p) ++at;
+                if (at == sorted.size() || sorted[at] != p) throw std::logic_error("a ray of a pixel not asked for");
+                ++in_sorted[at];
             }
+            std::vector<std::size_t> n(batch.size());
+            for (std::size_t k = 0; k < batch.size(); ++k) n[k] = in_sorted[set.rank(batch[k])];
             return n;
         });
     // The taken pixels' rays in the distribution's order: by pixel, each pixel's in its order

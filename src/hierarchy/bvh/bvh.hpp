@@ -194,8 +194,14 @@ private:
                    bool& found, PrimTest& test) const {
         for (const LeafPrim* p = prims_.data() + first; p != prims_.data() + first + count; ++p) {
             bool met;
-            if constexpr (std::is_same_v<PrimTest, RealPrimTest>) met = test_prim(*scene_, *p, ray, shear, hit, counting);
-            else met = test(p->id, ray, hit, counting);
+            if constexpr (std::is_same_v<PrimTest, RealPrimTest>) {
+                met = test_prim(*scene_, *p, ray, shear, hit, counting);
+            } else if constexpr (std::is_same_v<PrimTest, CrossingCollector>) {
+                Hit h = hit;
+                met = test_prim(*scene_, *p, ray, shear, h, counting) && test.keep(p->id, h.t, hit);
+            } else {
+                met = test(p->id, ray, hit, counting);
+            }
             if (met) {
                 found = true;
                 if constexpr (Q == Query::Any) return true;

@@ -44,6 +44,10 @@ public:
         self().template trace<Count, Query::All>(ray, hit, c);
     }
 
+    /// One closest-hit traversal whose primitive test collects the crossings (CrossingCollector)
+    /// where the traversal takes its test (`trace_with`); restarted queries otherwise.
+    std::size_t crossings(const Ray& ray, std::span<Crossing> out) const final;
+
 private:
     const Derived& self() const { return static_cast<const Derived&>(*this); }
 };
@@ -76,5 +80,60 @@ struct RealPrimTest {
         return test_prim(scene, id, ray, hit, counting);
     }
 };
+
+/// The primitive test of a search for a ray's first crossings (Hierarchy::crossings): a
+/// closest-hit traversal with it ends at the last of the `out.size()` nearest primitives met,
+/// which it keeps in `out`, nearest first (a tie after the earlier found). Until `out` is full no
+/// hit is reported, so the traversal cuts nothing; then the hit is the farthest kept, and
+/// everything beyond it is cut. A primitive kept is not tested again (it may be referenced by
+/// several cells); one dropped lies beyond the hit and fails its test again.
+struct CrossingCollector {
+    const Scene& scene;
+    std::span<Crossing> out;
+    std::size_t& n;
+    template <class C>
+    bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, C&) const {
+        if (kept(id)) return false;
+        Ray r = ray;
+        r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
+        float t;
+        return scene.intersect(id, r, t) && keep(id, t, hit);
+    }
+    /// Whether primitive `id` is kept already.
+    bool kept(std::uint32_t id) const {
+        for (std::size_t i = 0; i < n; ++i)
+            if (out[i].prim == id) return true;
+        return false;
+    }
+    /// Keeps primitive `id`, met at `t` (nearer than `hit.t`), unless kept already; true when
+    /// `hit` then holds the farthest kept of a full `out`. A traversal with its own exact test
+    /// (bvh: its triangle copies) calls this after it instead of the operator.
+    bool keep(std::uint32_t id, float t, Hit& hit) const {
+        if (out.empty() || kept(id)) return false;
+        std::size_t at = n < out.size() ? n++ : n - 1;  // full: the farthest is dropped
+        for (; at > 0 && out[at - 1].t > t; --at) out[at] = out[at - 1];
+        out[at] = {id, t};
+        if (n < out.size()) return false;
+        hit.t = out[n - 1].t;
+        hit.prim = static_cast<std::int32_t>(out[n - 1].prim);
+        return true;
+    }
+};
+
+template <class Derived>
+std::size_t HierarchyImpl<Derived>::crossings(const Ray& ray, std::span<Crossing> out) const {
+    std::size_t n = 0;
+    const CrossingCollector collect{*scene_, out, n};
+    if constexpr (requires(Hit& hit, NoCount& c) {
+                      self().template trace_with<NoCount, Query::Closest>(ray, hit, c, collect);
+                  }) {
+        Hit hit;
+        NoCount c;
+        self().template trace_with<NoCount, Query::Closest>(ray, hit, c, collect);
+        return n;
+    } else {
+        return Hierarchy::crossings(ray, out);
+    }
+}
 
 }  // namespace rtcost
