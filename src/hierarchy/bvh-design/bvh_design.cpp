@@ -11,6 +11,7 @@
 #include <map>
 
 #include "../bvh/topdown.hpp"
+#include "boxes_met.hpp"
 #include "design/replay.hpp"
 #include "occlusion_order.hpp"
 #include "rtcost/design.hpp"
@@ -37,47 +38,74 @@ struct Cut {
     std::uint32_t n_left = 0, n_right = 0;
 };
 
-// Every bin boundary on every axis with its surface-area cost, cheapest first.
-std::vector<Cut> binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
-                             const PrimInfo& info, const Box3& cb, int nbins) {
-    std::vector<Cut> cuts;
+// Buffers of binned_cuts, reused from node to node.
+struct CutScratch {
     struct Bin {
         Box3 box;
         std::uint32_t n = 0;
     };
-    std::vector<Bin> bins(nbins);
-    std::vector<Box3> suffix(nbins + 1);
-    std::vector<std::uint32_t> suffix_n(nbins + 1);
+    std::vector<Bin> bins;
+    std::vector<Box3> suffix;
+    std::vector<std::uint32_t> suffix_n;
+    std::vector<Cut> all;
+    std::vector<std::uint32_t> order;
+};
+
+// The `keep` cheapest of every bin boundary on every axis by surface-area cost, cheapest first
+// (ties in the order of generation: axis, then bin), into `cuts`.
+void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end, const PrimInfo& info,
+                 const Box3& cb, int nbins, std::size_t keep, CutScratch& sc, std::vector<Cut>& cuts) {
+    sc.all.clear();
+    sc.bins.assign(3 * nbins, CutScratch::Bin{});
+    sc.suffix.resize(nbins + 1);
+    sc.suffix_n.resize(nbins + 1);
+    // One pass over the primitives fills the three axes' bins.
+    float lo[3], scale[3];
     for (int axis = 0; axis < 3; ++axis) {
-        const float lo = cb.lo[axis], ext = cb.hi[axis] - lo;
-        if (!(ext > 0)) continue;
-        const float scale = nbins / ext;
-        std::fill(bins.begin(), bins.end(), Bin{});
-        for (std::uint32_t i = begin; i < end; ++i) {
-            const int b = std::min(nbins - 1, static_cast<int>((info.centroids[ids[i]][axis] - lo) * scale));
-            bins[b].box.extend(info.bounds[ids[i]]);
-            ++bins[b].n;
+        lo[axis] = cb.lo[axis];
+        const float ext = cb.hi[axis] - lo[axis];
+        scale[axis] = ext > 0 ? nbins / ext : 0;
+    }
+    for (std::uint32_t i = begin; i < end; ++i) {
+        const Vec3& c = info.centroids[ids[i]];
+        const Box3& bounds = info.bounds[ids[i]];
+        for (int axis = 0; axis < 3; ++axis) {
+            const int b = std::min(nbins - 1, static_cast<int>((c[axis] - lo[axis]) * scale[axis]));
+            CutScratch::Bin& bin = sc.bins[axis * nbins + b];
+            bin.box.extend(bounds);
+            ++bin.n;
         }
-        suffix[nbins] = Box3{};
-        suffix_n[nbins] = 0;
+    }
+    for (int axis = 0; axis < 3; ++axis) {
+        if (!(cb.hi[axis] - lo[axis] > 0)) continue;
+        const CutScratch::Bin* bins = sc.bins.data() + axis * nbins;
+        sc.suffix[nbins] = Box3{};
+        sc.suffix_n[nbins] = 0;
         for (int b = nbins - 1; b >= 0; --b) {
-            suffix[b] = suffix[b + 1];
-            suffix[b].extend(bins[b].box);
-            suffix_n[b] = suffix_n[b + 1] + bins[b].n;
+            sc.suffix[b] = sc.suffix[b + 1];
+            sc.suffix[b].extend(bins[b].box);
+            sc.suffix_n[b] = sc.suffix_n[b + 1] + bins[b].n;
         }
         Box3 prefix;
         std::uint32_t n = 0;
         for (int b = 0; b + 1 < nbins; ++b) {
             prefix.extend(bins[b].box);
             n += bins[b].n;
-            if (n == 0 || suffix_n[b + 1] == 0) continue;
-            cuts.push_back({axis, b + 1, prefix.area() * n + suffix[b + 1].area() * suffix_n[b + 1], prefix,
-                            suffix[b + 1], n, suffix_n[b + 1]});
+            if (n == 0 || sc.suffix_n[b + 1] == 0) continue;
+            sc.all.push_back({axis, b + 1, prefix.area() * n + sc.suffix[b + 1].area() * sc.suffix_n[b + 1], prefix,
+                              sc.suffix[b + 1], n, sc.suffix_n[b + 1]});
         }
     }
-    // Ties keep the order of generation (axis, then bin), as a strict "<" over them would.
-    std::stable_sort(cuts.begin(), cuts.end(), [](const Cut& a, const Cut& b) { return a.sah < b.sah; });
-    return cuts;
+    // The first `keep` of a stable sort by cost: ties to the earlier generated.
+    keep = std::min(keep, sc.all.size());
+    sc.order.resize(sc.all.size());
+    for (std::uint32_t i = 0; i < sc.order.size(); ++i) sc.order[i] = i;
+    std::partial_sort(sc.order.begin(), sc.order.begin() + static_cast<std::ptrdiff_t>(keep), sc.order.end(),
+                      [&](std::uint32_t x, std::uint32_t y) {
+                          return sc.all[x].sah < sc.all[y].sah || (sc.all[x].sah == sc.all[y].sah && x < y);
+                      });
+    cuts.clear();
+    for (std::size_t i = 0; i < keep; ++i) cuts.push_back(sc.all[sc.order[i]]);
 }
 
 struct Designed {
@@ -132,6 +160,12 @@ Designed build_design(const Scene& s, const DesignInput& in, const DesignOptions
             if (meets(r, s.bounds())) all.push_back(r);
         reaching[0] = std::move(all);
     }
+    // Reused from node to node: the candidates' boxes and the segments meeting each.
+    std::vector<Box3> boxes;
+    BoxColumns columns;
+    std::vector<std::vector<std::uint32_t>> met;
+    CutScratch scratch;
+    std::vector<Cut> cuts;
     BvhData data = build_topdown(s, info, [&](std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
                                       const Box3& box, int depth) -> std::uint32_t {
         std::vector<std::uint32_t> rays = std::move(reaching[begin]);
@@ -140,27 +174,40 @@ Designed build_design(const Scene& s, const DesignInput& in, const DesignOptions
         if (depth >= o.max_depth) return begin;
         Box3 cb;
         for (std::uint32_t i = begin; i < end; ++i) cb.extend(info.centroids[ids[i]]);
-        std::vector<Cut> cuts = binned_cuts(ids, begin, end, info, cb, o.bins);
         const double area = box.area();
         const double m = static_cast<double>(rays.size());
         // trust >= kNoTrust: the surface area alone, computed as bvh-sah computes it (in float, the
         // first cheapest cut), so that the design falls back to the SAH's tree exactly.
         const double w = o.trust >= kNoTrust ? 0 : m / (m + o.trust);
+        binned_cuts(ids, begin, end, info, cb, o.bins, w == 0 ? 1 : static_cast<std::size_t>(o.candidates), scratch,
+                    cuts);
         // Expected cost below this node, per ray reaching it: a leaf tests every primitive; a split
         // tests both child boxes and each child's primitives as often as the child is entered.
         double best = kInf;
         int chosen = -1;
         std::vector<std::uint32_t> best_left, best_right;
         const int k = std::min<int>(w == 0 ? 1 : o.candidates, static_cast<int>(cuts.size()));
+        // The segments meeting each candidate's left and right box (met[2c], met[2c + 1]), as
+        // meets() finds them, all boxes of a ray at once.
+        if (w > 0) {
+            boxes.clear();
+            for (int c = 0; c < k; ++c) boxes.insert(boxes.end(), {cuts[c].left, cuts[c].right});
+            columns.assign(boxes);
+            met.resize(std::max(met.size(), boxes.size()));
+            for (std::size_t j = 0; j < boxes.size(); ++j) met[j].clear();
+            for (std::uint32_t r : rays) {
+                const Ray& ray = smp.rays.rays[r];
+                columns.each_met(inv[r], ray.tmin, std::min(ray.tmax, smp.t_end[r]),
+                                 [&](std::size_t j) { met[j].push_back(r); });
+            }
+        }
         for (int c = 0; c < k; ++c) {
             const Cut& cut = cuts[c];
             double pl = area > 0 ? cut.left.area() / area : 1, pr = area > 0 ? cut.right.area() / area : 1;
             std::vector<std::uint32_t> lr, rr;
             if (w > 0) {
-                for (std::uint32_t r : rays) {
-                    if (meets(r, cut.left)) lr.push_back(r);
-                    if (meets(r, cut.right)) rr.push_back(r);
-                }
+                lr = std::move(met[2 * c]);
+                rr = std::move(met[2 * c + 1]);
                 pl = w * (lr.size() / m) + (1 - w) * pl;
                 pr = w * (rr.size() / m) + (1 - w) * pr;
             }
