@@ -4,6 +4,7 @@
 #include <random>
 #include <set>
 
+#include "../src/hierarchy/kd/float_sort.hpp"
 #include "../src/hierarchy/kd/kdtree.hpp"
 #include "test_support.hpp"
 
@@ -25,6 +26,34 @@ const std::vector<std::pair<std::string, std::vector<std::string>>> kKdVariants 
 Triangle unit_tri(float x0) { return Triangle{{x0, 0, 0}, {x0 + 1, 1, 0}, {x0, 1, 1}}; }
 
 // --- structure -------------------------------------------------------------------------------
+
+TEST(KdBuild, EdgeSortAndNeighbouringFloatsEqualTheStandardLibrarys) {
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<float> u(-1000, 1000);
+    const float specials[] = {0.0f, -0.0f, 1e-40f, -1e-40f, std::numeric_limits<float>::denorm_min(),
+                              -std::numeric_limits<float>::max(), std::numeric_limits<float>::max(), 1.0f, -1.0f};
+    std::vector<float> scratch;
+    for (std::size_t n : {0u, 1u, 5u, 1023u, 1024u, 5000u, 70000u}) {
+        std::vector<float> v(n);
+        for (std::size_t i = 0; i < n; ++i) v[i] = i % 7 == 0 ? specials[i % 9] : (i % 3 ? u(rng) : std::round(u(rng)));
+        std::vector<float> want = v;
+        std::sort(want.begin(), want.end());
+        kd::sort_floats(v, scratch);
+        ASSERT_EQ(v.size(), n);
+        EXPECT_TRUE(std::is_sorted(v.begin(), v.end())) << n;
+        // Equal values in the same places (-0 and +0 compare equal).
+        EXPECT_TRUE(std::equal(v.begin(), v.end(), want.begin())) << n;
+    }
+    for (float x : specials) {
+        EXPECT_EQ(std::bit_cast<std::uint32_t>(kd::float_below(x)), std::bit_cast<std::uint32_t>(std::nextafter(x, -kInf))) << x;
+        EXPECT_EQ(std::bit_cast<std::uint32_t>(kd::float_above(x)), std::bit_cast<std::uint32_t>(std::nextafter(x, kInf))) << x;
+    }
+    for (int i = 0; i < 1000; ++i) {
+        const float x = u(rng);
+        EXPECT_EQ(kd::float_below(x), std::nextafter(x, -kInf));
+        EXPECT_EQ(kd::float_above(x), std::nextafter(x, kInf));
+    }
+}
 
 TEST(KdStructure, MedianCutOnFourTrianglesInARow) {
     // x ranges [0,1], [2,3], [4,5], [6,7]; y and z span the whole box, so only x can separate.

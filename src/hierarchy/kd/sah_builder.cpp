@@ -18,6 +18,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "float_sort.hpp"
 #include "kdtree.hpp"
 
 namespace rtcost::kd {
@@ -37,7 +38,7 @@ Split sah_plane(const std::vector<BuildRef>& refs, const Box3& cell, const SahOp
     const double leaf_cost = double(o.c_isect) * double(n);
     double best_cost = must_split ? kInf : leaf_cost;
     Split best;
-    std::vector<float> lo(n), hi(n);
+    std::vector<float> lo(n), hi(n), scratch;
     for (int a = 0; a < 3; ++a) {
         const float clo = cell.lo[a], chi = cell.hi[a];
         if (!(chi > clo)) continue;
@@ -45,8 +46,8 @@ Split sah_plane(const std::vector<BuildRef>& refs, const Box3& cell, const SahOp
             lo[i] = refs[i].box.lo[a];
             hi[i] = refs[i].box.hi[a];
         }
-        std::sort(lo.begin(), lo.end());
-        std::sort(hi.begin(), hi.end());
+        sort_floats(lo, scratch);
+        sort_floats(hi, scratch);
         // Cross-section of the cell perpendicular to `a`, and the perimeter factor: S(side of
         // length l) = 2 (cross + l (e1 + e2)).
         const int a1 = (a + 1) % 3, a2 = (a + 2) % 3;
@@ -72,12 +73,12 @@ Split sah_plane(const std::vector<BuildRef>& refs, const Box3& cell, const SahOp
             while (j < n && hi[j] == v) ++j;
             const float next = std::min(i < n ? lo[i] : kInf, j < n ? hi[j] : kInf);
             // Just below v: boxes starting at v lie wholly right.
-            const float below = std::nextafter(v, -kInf);
+            const float below = float_below(v);
             if (below > prev) evaluate(below, lo_before, n - hi_before);
             // At v: boxes starting or ending at v are on both sides.
             evaluate(v, i, n - hi_before);
             // Just above v: boxes ending at v lie wholly left.
-            const float above = std::nextafter(v, kInf);
+            const float above = float_above(v);
             if (above < next) evaluate(above, i, n - j);
             prev = v;
         }
