@@ -1,9 +1,11 @@
 // The designed hierarchies: exact hits like every hierarchy (closest and any-hit), the same
 // structure for the same seed, the SAH's tree where the sample is given no weight, a grid
 // resolution no worse on the sample than the formula's, and `rtcost design`'s rows.
+#include <random>
 #include <type_traits>
 
 #include "../src/design/sample_reach.hpp"
+#include "../src/hierarchy/bvh-design/boxes_met.hpp"
 #include "../src/hierarchy/bsp/bsp.hpp"
 #include "../src/design/replay.hpp"
 #include "../src/hierarchy/octree/octree.hpp"
@@ -292,6 +294,42 @@ TEST(Design, DesignReportsEachFamilyOnDisjointRays) {
     EXPECT_EQ(j["results"][0]["family"], "grid");
     EXPECT_EQ(j["results"][0]["designed"], "grid-design");
     EXPECT_EQ(j["results"][0]["set"][0], "rays=spd");
+}
+
+TEST(BvhDesign, BoxesMetFourAtATimeAsBoxEntryFindsThem) {
+    // Random boxes and segments, and the hard cases: zero direction components, origins in a
+    // box's face plane, flat boxes, a box touching the segment's end.
+    std::mt19937 rng(3);
+    std::uniform_real_distribution<float> u(-2, 2);
+    std::vector<Box3> boxes;
+    for (int i = 0; i < 13; ++i) {
+        Box3 b;
+        b.extend(Vec3{u(rng), u(rng), u(rng)});
+        b.extend(Vec3{u(rng), u(rng), u(rng)});
+        if (i % 5 == 0) b.hi.y = b.lo.y;  // flat
+        boxes.push_back(b);
+    }
+    boxes.push_back(Box3{{0, 0, 0}, {1, 1, 1}});
+    bvh::BoxColumns columns;
+    columns.assign(boxes);
+    std::size_t met_total = 0, tested = 0;
+    for (int r = 0; r < 4000; ++r) {
+        Ray ray{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, 0, r % 3 ? kInf : std::fabs(u(rng))};
+        if (r % 7 == 0) ray.d[r % 3] = 0;
+        if (r % 11 == 0) ray.d = Vec3{0, 0, r % 2 ? 1.0f : -1.0f};
+        if (r % 13 == 0) ray.o.x = 1;  // in a face plane of the unit box
+        if (r % 17 == 0) ray.o = Vec3{0.5f, 0.5f, -1}, ray.d = Vec3{0, 0, 1}, ray.tmax = 1;  // ends at its face
+        const RayInv ri(ray);
+        std::vector<char> want(boxes.size()), got(boxes.size());
+        for (std::size_t j = 0; j < boxes.size(); ++j) want[j] = box_entry(boxes[j], ri, ray.tmin, ray.tmax) != kInf;
+        columns.each_met(ri, ray.tmin, ray.tmax, [&](std::size_t j) { got[j] = 1; });
+        ASSERT_EQ(got, want) << "ray " << r;
+        for (char w : want) met_total += w;
+        tested += boxes.size();
+    }
+    // Both answers are common.
+    EXPECT_GT(met_total, tested / 50);
+    EXPECT_LT(met_total, tested * 9 / 10);
 }
 
 }  // namespace

@@ -1,7 +1,7 @@
 #pragma once
 // Which of a few boxes each sample segment meets: bvh-design weighs 8 candidate splits at every
-// node, two boxes each, against every sample segment reaching the node, which was a third of its
-// design time one box at a time. Four boxes per ray at once with SSE here, decided exactly as
+// node, two boxes each, against every sample segment reaching the node (with the binning of the
+// candidates, a third of its design time). Four boxes per ray at once with SSE here, decided exactly as
 // box_entry decides one (the same operations in the same order; max/min keep the second operand
 // on NaN as box_entry's compares do), so the design is the same tree.
 #include <cstdint>
