@@ -196,7 +196,9 @@ private:
             bool met;
             if constexpr (std::is_same_v<PrimTest, RealPrimTest>) {
                 met = test_prim(*scene_, *p, ray, shear, hit, counting);
-            } else if constexpr (std::is_same_v<PrimTest, CrossingCollector>) {
+            } else if constexpr (requires { test.keep(p->id, 0.0f, hit); }) {
+                // A test that only sorts real hits (CrossingCollector) is given the leaves' own
+                // exact test first, as a real trace is.
                 Hit h = hit;
                 met = test_prim(*scene_, *p, ray, shear, h, counting) && test.keep(p->id, h.t, hit);
             } else {

@@ -89,7 +89,7 @@ struct RealPrimTest {
 /// several cells); one dropped lies beyond the hit and fails its test again.
 struct CrossingCollector {
     const Scene& scene;
-    std::span<Crossing> out;
+    std::span<Crossing> out;  ///< not empty
     std::size_t& n;
     template <class C>
     bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, C&) const {
@@ -97,19 +97,20 @@ struct CrossingCollector {
         Ray r = ray;
         r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
         float t;
-        return scene.intersect(id, r, t) && keep(id, t, hit);
+        return scene.intersect(id, r, t) && insert(id, t, hit);
     }
-    /// Whether primitive `id` is kept already.
+    /// Keeps primitive `id`, met at `t` (nearer than `hit.t`) by a traversal's own exact test
+    /// (bvh: its triangle copies), unless kept already; true when `hit` then holds the
+    /// farthest kept of a full `out`.
+    bool keep(std::uint32_t id, float t, Hit& hit) const { return !kept(id) && insert(id, t, hit); }
+
+private:
     bool kept(std::uint32_t id) const {
         for (std::size_t i = 0; i < n; ++i)
             if (out[i].prim == id) return true;
         return false;
     }
-    /// Keeps primitive `id`, met at `t` (nearer than `hit.t`), unless kept already; true when
-    /// `hit` then holds the farthest kept of a full `out`. A traversal with its own exact test
-    /// (bvh: its triangle copies) calls this after it instead of the operator.
-    bool keep(std::uint32_t id, float t, Hit& hit) const {
-        if (out.empty() || kept(id)) return false;
+    bool insert(std::uint32_t id, float t, Hit& hit) const {
         std::size_t at = n < out.size() ? n++ : n - 1;  // full: the farthest is dropped
         for (; at > 0 && out[at - 1].t > t; --at) out[at] = out[at - 1];
         out[at] = {id, t};
@@ -122,6 +123,7 @@ struct CrossingCollector {
 
 template <class Derived>
 std::size_t HierarchyImpl<Derived>::crossings(const Ray& ray, std::span<Crossing> out) const {
+    if (out.empty()) return 0;
     std::size_t n = 0;
     const CrossingCollector collect{*scene_, out, n};
     if constexpr (requires(Hit& hit, NoCount& c) {
