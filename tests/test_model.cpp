@@ -7,6 +7,7 @@
 
 #include "rtcost/model.hpp"
 #include "test_support.hpp"
+#include "util/rng.hpp"
 
 namespace rtcost::test {
 namespace {
@@ -52,6 +53,46 @@ TEST(ModelSampled, Rc5dOrderedSearchOnCameraRays) {
     ModelOptions all;
     all.query = Query::All;
     EXPECT_LT(ps.scalar, predict_sampled(h->model_tree(), s, train, all).scalar);
+}
+
+// Coplanar faces: a floor of tiles, all in one plane across the dominant axis of rays coming
+// down on it. Every tile's near face is that plane, so whether the ordered search tests the
+// tiles after the one hit hangs on the traversal's own padding of boxes and its stopping
+// margin (a rounding either way of the hit's t). The probe on the very rays it is trained on
+// must count what the traversal counts.
+TEST(ModelSampled, Rc5dOrderedSearchOverCoplanarFacesCountsWhatTheTraversalTests) {
+    Scene s;
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) {
+            const float x = float(i), y = float(j);
+            s.add(Triangle{{x, y, 0}, {x + 1, y, 0}, {x + 1, y + 1, 0}}, 0);
+            s.add(Triangle{{x, y, 0}, {x + 1, y + 1, 0}, {x, y + 1, 0}}, 0);
+        }
+    s.add(Triangle{{0, 0, 2}, {12, 0, 2}, {0, 0, 3}}, 0);  // something above, for a box of height
+    s.finalize();
+    Rng rng(5);
+    std::vector<Ray> rays;
+    for (int k = 0; k < 4000; ++k) {
+        const Vec3 o{float(rng.uniform() * 12), float(rng.uniform() * 12), 1.5f + float(rng.uniform())};
+        rays.push_back(Ray{o, {float(rng.uniform() - 0.5) * 0.6f, float(rng.uniform() - 0.5) * 0.6f, -1.0f}});
+    }
+    auto h = build_hierarchy(s, "rc5d", {"build=eager", "max_depth=6", "max_prims=64"});
+    for (Query q : {Query::Closest, Query::Any}) {
+        ModelOptions o;
+        o.query = q;
+        const Prediction p = predict_sampled(h->model_tree(), s, rays, o);
+        RayCounters total;
+        for (const Ray& r : rays) {
+            Hit hit;
+            if (q == Query::Closest) h->closest(r, hit, total);
+            else h->any(r, hit, total);
+        }
+        const CostVector m = measured_cost(total);
+        // The closest-hit search runs on past the tile hit, over the tiles in its plane.
+        if (q == Query::Closest) ASSERT_GT(m.prim_tests(), 2.0);
+        EXPECT_NEAR(p.cost.prim_tests(), m.prim_tests(), 1e-6 * m.prim_tests()) << "query " << static_cast<int>(q);
+        EXPECT_NEAR(p.cost.classify, m.classify, 1e-6 * m.classify);
+    }
 }
 
 // The sampled estimator's probe walks the model tree as the traversal does, so on its own

@@ -85,6 +85,14 @@ struct ModelFlags {
     /// are disjoint sets of rays), whose leaf candidates are searched in order of their start
     /// along the dominant axis and the search stops early.
     bool one_path = false;
+    /// The ordered search of a one-path leaf, as the traversal runs it: a candidate's start is
+    /// its bounding box's near face moved outwards by `search_pad` (in float, as the traversal
+    /// stores it), and the search stops once a start lies beyond the current hit's dominant
+    /// coordinate plus `stop_margin` times the magnitudes of that coordinate's two terms.
+    /// Without these, candidates whose near face lies in the hit's plane (coplanar faces) were
+    /// predicted untested while the traversal tests them.
+    float search_pad = 0;
+    double stop_margin = 0;
     /// A closest-hit query skips what lies beyond the nearest hit found so far (false: the
     /// traversal visits everything the segment meets, e.g. a BVH with `order=none`).
     bool cull = true;

@@ -170,9 +170,18 @@ void scale_to_share(Prediction& p, const ModelTree& t, double share, const UnitC
 // ---- 5D ray classification (beams.cpp)
 /// Line-measure weight of a beam with directions `m` whose origins lie in `o` (inside root box `b`).
 double beam_weight(const ModelBeam& m, const Box3& o, const Box3& b);
-/// Forward start of a primitive along a beam's dominant axis (its bounding box's near face).
-inline double forward_start(const Box3& pb, int k, bool negative) {
-    return negative ? -double(pb.hi[k]) : double(pb.lo[k]);
+/// Forward start of a primitive along a beam's dominant axis: its bounding box's near face,
+/// moved outwards by `pad` in float as the 5D traversal pads its boxes (ModelFlags::search_pad).
+inline double forward_start(const Box3& pb, int k, bool negative, float pad = 0) {
+    return negative ? -double(pb.hi[k] + pad) : double(pb.lo[k] - pad);
+}
+/// Where a one-path leaf's ordered search stops: the dominant coordinate of the parameter `t`
+/// (`so` the origin's, `adk` the direction's magnitude on that axis), plus the traversal's
+/// relative `margin` (ModelFlags::stop_margin). Infinite for an infinite `t`.
+inline double search_stop(double so, float t, double adk, double margin) {
+    if (!(t < kInf)) return kInf;
+    const double dist = double(t) * adk;
+    return so + dist + margin * (std::fabs(so) + std::fabs(dist));
 }
 
 }  // namespace rtcost::model

@@ -96,8 +96,8 @@ Prediction predict_one_path(const ModelTree& t, const Walk& w, const Scene& scen
         oracle.begin(r);
         for (std::uint32_t c = 0; c < leaf.count; ++c) {
             std::uint32_t id = t.prims[leaf.first + c];
-            const double stop = terminate ? so + double(std::min(hit.t, ray.tmax)) * adk : kInf;
-            if (forward_start(scene.prim_bounds(id), k, neg) > stop) break;
+            const double stop = terminate ? search_stop(so, std::min(hit.t, ray.tmax), adk, t.stop_margin) : kInf;
+            if (forward_start(scene.prim_bounds(id), k, neg, t.search_pad) > stop) break;
             tests[node][static_cast<int>(scene.kind(id))] += 1;
             if (oracle.test(id, ray, hit) && terminate && opt.query == Query::Any) break;
         }

@@ -224,6 +224,8 @@ bool Rc5d::emit_model(ModelSink& sink) const {
     f.per_ray_box = 1;
     f.per_entry_hop = 0;
     f.one_path = true;
+    f.search_pad = static_cast<float>(pad_);
+    f.stop_margin = kStopMargin;
     if (!sink.begin(f)) return true;
     ModelNode root;
     root.region = box_;
