@@ -89,7 +89,9 @@ TEST(ModelSampled, Rc5dOrderedSearchOverCoplanarFacesCountsWhatTheTraversalTests
         }
         const CostVector m = measured_cost(total);
         // The closest-hit search runs on past the tile hit, over the tiles in its plane.
-        if (q == Query::Closest) ASSERT_GT(m.prim_tests(), 2.0);
+        if (q == Query::Closest) {
+            ASSERT_GT(m.prim_tests(), 2.0);
+        }
         EXPECT_NEAR(p.cost.prim_tests(), m.prim_tests(), 1e-6 * m.prim_tests()) << "query " << static_cast<int>(q);
         EXPECT_NEAR(p.cost.classify, m.classify, 1e-6 * m.classify);
     }
