@@ -175,6 +175,35 @@ double beam_weight(const ModelBeam& m, const Box3& o, const Box3& b);
 inline double forward_start(const Box3& pb, int k, bool negative, float pad = 0) {
     return negative ? -double(pb.hi[k] + pad) : double(pb.lo[k] - pad);
 }
+/// A ray's point in 5D ray space as a one-path (5D) traversal classifies it: `x` the entry point
+/// (the ray's point at max(tmin, root box entry), clamped to `root`) and the direction's (u, v)
+/// on the face of its dominant axis `k` (sign `neg`, magnitude `adk`). False when the ray
+/// misses `root` or has no direction: it reaches no cube. The probe and the reached tree share
+/// it, so that both follow each ray down the same path.
+inline bool classify_5d(const Ray& ray, const Box3& root, double x[5], int& k, bool& neg, double& adk) {
+    const RayInv ri(ray);
+    if (box_entry(root, ri.o, ri.inv, ray.tmin, ray.tmax) == kInf) return false;
+    k = max_axis(ray.d);
+    adk = std::fabs(double(ray.d[k]));
+    if (!(adk > 0)) return false;
+    double t0 = ray.tmin;
+    for (int a = 0; a < 3; ++a) {
+        if (ray.d[a] == 0) continue;
+        const double bound = ray.d[a] > 0 ? root.lo[a] : root.hi[a];
+        t0 = std::max(t0, (bound - double(ray.o[a])) / double(ray.d[a]));
+    }
+    for (int a = 0; a < 3; ++a)
+        x[a] = std::clamp(double(ray.o[a]) + (ray.d[a] != 0 ? t0 * double(ray.d[a]) : 0.0), double(root.lo[a]),
+                          double(root.hi[a]));
+    const int i1 = k == 0 ? 1 : 0, i2 = k == 2 ? 1 : 2;
+    x[3] = float(ray.d[i1] / float(adk));
+    x[4] = float(ray.d[i2] / float(adk));
+    neg = ray.d[k] < 0;
+    return true;
+}
+/// The child of a 5D node that a ray's point `x` falls in (0 below the split, 1 at or above).
+inline std::uint32_t beam_side(const ModelNode& m, const double x[5]) { return float(x[m.beam_dim]) >= m.split ? 1u : 0u; }
+
 /// Where a one-path leaf's ordered search stops: the dominant coordinate of the parameter `t`
 /// (`so` the origin's, `adk` the direction's magnitude on that axis), plus the traversal's
 /// relative `margin` (ModelFlags::stop_margin). Infinite for an infinite `t`.

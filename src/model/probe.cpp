@@ -58,35 +58,21 @@ Prediction predict_one_path(const ModelTree& t, const Walk& w, const Scene& scen
     std::size_t met = 0;
     for (std::size_t r = 0; r < training.size(); ++r) {
         const Ray& ray = training[r];
-        const RayInv ri(ray);
-        if (box_entry(root, ri.o, ri.inv, ray.tmin, ray.tmax) == kInf) continue;
-        const int k = max_axis(ray.d);
-        const double adk = std::fabs(double(ray.d[k]));
-        if (!(adk > 0)) continue;
-        ++met;
-        // The classification point: the ray's point at max(tmin, box entry), clamped to the box.
-        double t0 = ray.tmin;
-        for (int a = 0; a < 3; ++a) {
-            if (ray.d[a] == 0) continue;
-            double bound = ray.d[a] > 0 ? root.lo[a] : root.hi[a];
-            t0 = std::max(t0, (bound - double(ray.o[a])) / double(ray.d[a]));
-        }
         double x[5];
-        for (int a = 0; a < 3; ++a)
-            x[a] = std::clamp(double(ray.o[a]) + (ray.d[a] != 0 ? t0 * double(ray.d[a]) : 0.0), double(root.lo[a]),
-                              double(root.hi[a]));
-        const int i1 = k == 0 ? 1 : 0, i2 = k == 2 ? 1 : 2;
-        x[3] = float(ray.d[i1] / float(adk));
-        x[4] = float(ray.d[i2] / float(adk));
-        const bool neg = ray.d[k] < 0;
+        int k = 0;
+        bool neg = false;
+        double adk = 0;
+        if (!classify_5d(ray, root, x, k, neg, adk)) continue;
+        ++met;
         std::uint32_t node = 0;
         handed[0] += 1;
         node = t.nodes[0].first + static_cast<std::uint32_t>(2 * k + (neg ? 1 : 0));
         for (;;) {
             handed[node] += 1;
             const ModelNode& m = t.nodes[node];
+            if (m.pruned) throw PrunedNodeReached{};  // a tree reached by other rays (reached_tree.cpp)
             if (m.leaf) break;
-            node = m.first + (float(x[m.beam_dim]) >= m.split ? 1u : 0u);
+            node = m.first + beam_side(m, x);
         }
         // The ordered search, with real tests: a candidate starting beyond the nearest hit so
         // far is not tested (closest), the first hit ends it (any).

@@ -32,14 +32,47 @@ public:
 
     bool begin(const ModelFlags& f) override {
         ModelCollector::begin(f);
-        // 5D trees classify rays instead of clipping them: kept whole.
-        whole_ = f.one_path;
-        seg_ = model::ReplaySegments(sample_, f.cull);
+        one_path_ = f.one_path;
+        if (!one_path_) seg_ = model::ReplaySegments(sample_, f.cull);
         return true;
     }
 
 private:
-    bool keep(const ModelNode& m, int depth) override { return whole_ || collect(m, depth); }
+    bool keep(const ModelNode& m, int depth) override { return one_path_ ? classify(m, depth) : collect(m, depth); }
+
+    /// 5D trees classify rays instead of clipping them: a node is kept when some sample ray's
+    /// 5D point falls in it, found as the probe follows each ray (classify_5d, beam_side).
+    /// Nodes arrive in pre-order, so the one at `depth` is the next child of the last node kept
+    /// one level up.
+    bool classify(const ModelNode& m, int depth) {
+        if (static_cast<std::size_t>(depth) + 1 >= paths_.size()) {
+            paths_.resize(depth + 2);
+            ordinal_.resize(depth + 2, 0);
+            parent_.resize(depth + 2);
+        }
+        std::vector<std::uint32_t>& out = paths_[depth];
+        out.clear();
+        if (depth == 0) {
+            points_.assign(sample_.size(), {});
+            for (std::uint32_t i = 0; i < sample_.size(); ++i) {
+                Point& p = points_[i];
+                int k = 0;
+                bool neg = false;
+                double adk = 0;
+                if (!model::classify_5d(sample_.rays.rays[i], m.region, p.x, k, neg, adk)) continue;
+                p.cube = static_cast<std::uint32_t>(2 * k + (neg ? 1 : 0));
+                out.push_back(i);
+            }
+        } else {
+            const std::uint32_t side = ordinal_[depth]++;
+            for (std::uint32_t i : paths_[depth - 1])
+                if ((depth == 1 ? points_[i].cube : model::beam_side(parent_[depth - 1], points_[i].x)) == side)
+                    out.push_back(i);
+        }
+        ordinal_[depth + 1] = 0;
+        parent_[depth] = m;
+        return !out.empty();
+    }
 
     /// Fills the segments that reach the node at `depth` from its parent's (depth - 1) and
     /// says whether there are any. Depth first, the last list one level up is the parent's.
@@ -78,9 +111,19 @@ private:
     }
 
     const RaySample& sample_;
-    bool whole_ = false;
+    bool one_path_ = false;
     model::ReplaySegments seg_;
     std::vector<std::vector<Reach>> by_depth_;
+    // 5D: each sample ray's point and cube; per depth, the rays in the node last kept there,
+    // that node, and the number of its siblings seen so far.
+    struct Point {
+        double x[5] = {};
+        std::uint32_t cube = ~0u;
+    };
+    std::vector<Point> points_;
+    std::vector<std::vector<std::uint32_t>> paths_;
+    std::vector<std::uint32_t> ordinal_;
+    std::vector<ModelNode> parent_;
 };
 
 ModelTree reached_model_tree(const Hierarchy& h, const RaySample& sample) {

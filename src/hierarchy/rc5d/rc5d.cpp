@@ -233,6 +233,7 @@ bool Rc5d::emit_model(ModelSink& sink) const {
     root.count = 6;
     root.classify = 3;
     sink.beam_node(root, ModelBeam{}, {});
+    if (sink.skip_children()) return true;  // no ray of the sink's reaches the scene box
     // `m` arrives with the beam's origin box, `b` with its directions; the node decides leaf or
     // split.
     auto emit = [&](auto&& self, const Node& n, const Cell& cell, int level, ModelNode m, const ModelBeam& b) -> void {
@@ -248,6 +249,7 @@ bool Rc5d::emit_model(ModelSink& sink) const {
         m.beam_dim = static_cast<std::int8_t>(dim);
         m.split = n.split;
         sink.beam_node(m, b, {});
+        if (sink.skip_children()) return;  // a reached tree (reached_tree.cpp) left it out
         for (int side = 0; side < 2; ++side) {
             const Cell c = child_cell(cell, dim, n.split, side);
             ModelNode k;
