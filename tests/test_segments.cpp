@@ -264,6 +264,11 @@ TEST(ModelSegments, TheReachedTreePredictsWhatTheWholeTreePredicts) {
             EXPECT_DOUBLE_EQ(a.cost.steps, b.cost.steps) << what;
             EXPECT_DOUBLE_EQ(a.cost.prim_tests(), b.cost.prim_tests()) << what;
             if (q == Query::Closest && reached < whole.nodes.size()) ++pruned_trees;
+            // A BVH's closest-hit search enters overlapping children before it finds its hit,
+            // beyond the ray's end: the reached tree holds them, so no replay falls back.
+            if (q == Query::Closest && whole.family == ModelFamily::Bvh) {
+                EXPECT_EQ(predictor.tree().nodes.size(), reached) << what << ": fell back on the whole tree";
+            }
             if (reached < whole.nodes.size() && q == Query::All && whole.cull && !whole.one_path) {
                 // The closest-hit sample's ends are not those of a search that never ends.
                 EXPECT_EQ(predictor.tree().nodes.size(), whole.nodes.size()) << what << ": fell back on the whole tree";
@@ -272,6 +277,33 @@ TEST(ModelSegments, TheReachedTreePredictsWhatTheWholeTreePredicts) {
     }
     // The subdivisions of a 820-sphere scene have far more cells than 200 rays meet.
     EXPECT_GE(pruned_trees, 5u);
+}
+
+// Where a BVH is far larger than its sample, only the part the sample reaches is materialised,
+// and that part holds every node a closest-hit replay enters: the overlapping children searched
+// before the hit is found, beyond the ray's end. Camera rays of a scene of many small spheres.
+TEST(ModelSegments, AReachedBvhHoldsWhatTheReplayEntersBeforeItsHit) {
+    Scene s = builtin_scene("balls", 5);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    RaySpec spec;
+    spec.size = "64x64";
+    const RaySet cam = make_rays(s, spec);
+    const RaySample smp = draw_sample_from(s, cam, 60, 5, *ref);
+    std::vector<std::uint32_t> idx(smp.size());
+    for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    for (const char* name : {"bvh-sah", "bvh-median", "bvh-gs", "bvh-wide"}) {
+        auto h = build_hierarchy(s, name);
+        const ModelTree whole = h->model_tree();
+        SegmentsPredictor predictor(*h, s, smp);
+        const std::size_t reached = predictor.tree().nodes.size();
+        EXPECT_LT(reached, whole.nodes.size() / 2) << name;
+        ModelOptions o;
+        const Prediction a = predictor.predict(idx, o), b = predict_segments(whole, s, smp, idx, o);
+        EXPECT_EQ(predictor.tree().nodes.size(), reached) << name << ": fell back on the whole tree";
+        EXPECT_DOUBLE_EQ(a.scalar, b.scalar) << name;
+        EXPECT_DOUBLE_EQ(a.cost.box, b.cost.box) << name;
+        EXPECT_DOUBLE_EQ(a.cost.prim_tests(), b.cost.prim_tests()) << name;
+    }
 }
 
 TEST(ModelSegments, ASampleOfAnotherSceneIsRefused) {

@@ -16,10 +16,48 @@ namespace rtcost {
 
 namespace {
 
-/// A segment of one sample ray, as far as it reaches into the node being emitted.
+/// A segment of one sample ray, as far as it reaches into the node being emitted. In a BVH,
+/// `full` is the whole ray's segment there, and `free` says that the node may be searched
+/// before the ray's hit is found, so everything the whole ray meets below it may be visited.
 struct Reach {
     std::uint32_t ray;
     Segment s;
+    Segment full;
+    bool free;
+};
+
+/// Where each node of an emitted tree lies in pre-order, and its subtree's extent: a first
+/// pass over a BVH, so that the reached tree knows which nodes hold a ray's hit.
+class PreorderIndex final : public ModelSink {
+public:
+    explicit PreorderIndex(std::size_t prims) : leaf_of(prims, ~0u) {}
+    std::vector<std::uint32_t> end;      ///< per node (pre-order): one past its subtree's last node
+    std::vector<std::uint32_t> leaf_of;  ///< per primitive: its leaf (pre-order), ~0u if none
+
+    /// Read only for a BVH searched front to back (the emitter stops otherwise).
+    bool begin(const ModelFlags& f) override { return read = f.family == ModelFamily::Bvh && f.cull; }
+    bool read = false;
+    void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
+        const auto k = static_cast<std::uint32_t>(end.size());
+        end.push_back(k + 1);
+        if (!open_.empty()) --open_.back().left;
+        if (!m.leaf && m.count > 0) {
+            open_.push_back({k, m.count});
+            return;
+        }
+        for (std::uint32_t p : prims)
+            if (p < leaf_of.size()) leaf_of[p] = k;
+        while (!open_.empty() && open_.back().left == 0) {
+            end[open_.back().node] = static_cast<std::uint32_t>(end.size());
+            open_.pop_back();
+        }
+    }
+
+private:
+    struct Open {
+        std::uint32_t node, left;
+    };
+    std::vector<Open> open_;
 };
 
 /// Materialises an emitted tree like Hierarchy::model_tree, but stands a subtree that none of
@@ -28,17 +66,45 @@ struct Reach {
 /// the parent's bounding volume) clipped to the child's region.
 class ReachCollector final : public ModelCollector {
 public:
-    ReachCollector(ModelTree& t, const RaySample& sample) : ModelCollector(t), sample_(sample) {}
+    /// `order`: the tree's pre-order index (PreorderIndex) for a BVH, else null.
+    ReachCollector(ModelTree& t, const RaySample& sample, const PreorderIndex* order)
+        : ModelCollector(t), sample_(sample), order_(order) {}
 
     bool begin(const ModelFlags& f) override {
         ModelCollector::begin(f);
         one_path_ = f.one_path;
         if (!one_path_) seg_ = model::ReplaySegments(sample_, f.cull);
+        // A BVH's children overlap: a closest-hit search enters a child met before the one that
+        // holds its hit, and searches it whole (on the whole ray, no hit known yet), reaching
+        // nodes beyond where the ray ends. Cells of a subdivision never overlap: a search past
+        // its end has stopped.
+        overlapping_ = f.family == ModelFamily::Bvh && f.cull && order_;
+        cursor_ = 0;
+        if (overlapping_) {
+            ends_at_.assign(sample_.size() + 1, 0);
+            end_leaves_.clear();
+            for (std::uint32_t i = 0; i < sample_.size(); ++i) {
+                // The leaves of the primitives found at the end (a tie keeps several): the
+                // nodes above them hold the hit.
+                if (seg_.ends[i] < sample_.rays.rays[i].tmax)
+                    for (const Crossing& c : sample_.crossings_of(i))
+                        if (c.t <= seg_.ends[i] && c.prim < order_->leaf_of.size())
+                            end_leaves_.push_back(order_->leaf_of[c.prim]);
+                ends_at_[i + 1] = static_cast<std::uint32_t>(end_leaves_.size());
+            }
+        }
         return true;
     }
 
 private:
-    bool keep(const ModelNode& m, int depth) override { return one_path_ ? classify(m, depth) : collect(m, depth); }
+    bool keep(const ModelNode& m, int depth) override {
+        if (one_path_) return classify(m, depth);
+        // This node's place in pre-order; the next one asked is past its subtree if it is dropped.
+        node_ = cursor_;
+        const bool kept = collect(m, depth);
+        if (overlapping_) cursor_ = kept ? node_ + 1 : order_->end.at(node_);
+        return kept;
+    }
 
     /// 5D trees classify rays instead of clipping them: a node is kept when some sample ray's
     /// 5D point falls in it, found as the probe follows each ray (classify_5d, beam_side).
@@ -80,22 +146,31 @@ private:
         if (static_cast<std::size_t>(depth) >= by_depth_.size()) by_depth_.resize(depth + 1);
         std::vector<Reach>& out = by_depth_[depth];
         out.clear();
-        auto add = [&](std::uint32_t ray, Segment s) {
+        // `s` clipped to the node's region (`met`: the region is met), and within it to its
+        // bounding volume (`s`: what its children see, empty when the volume is not met).
+        struct Clipped {
+            bool met;
+            Segment s;
+        };
+        auto clip = [&](std::uint32_t ray, Segment s) -> Clipped {
             s = clip_segment(seg_.inv[ray], m.region, s);
-            if (s.empty()) return;
-            // The node's children see the segment within its bounding volume.
+            if (s.empty()) return {false, s};
             if (m.has_bv) s = clip_segment(seg_.inv[ray], m.bv, s);
-            out.push_back({ray, s});
+            return {true, s};
         };
         if (depth == 0) {
             for (std::uint32_t i = 0; i < seg_.inv.size(); ++i) {
-                const Segment whole{sample_.rays.rays[i].tmin, seg_.ends[i]};
+                const Ray& ray = sample_.rays.rays[i];
+                const Segment whole{ray.tmin, seg_.ends[i]}, line{ray.tmin, ray.tmax};
+                // Without a hit known in advance, the whole ray.
+                const bool free = overlapping_ && ends_at_[i] == ends_at_[i + 1];
                 if (t_.gated) {
-                    add(i, whole);
+                    const Clipped c = clip(i, whole), f = overlapping_ ? clip(i, line) : c;
+                    if (c.met || (free && f.met)) out.push_back({i, free ? f.s : c.s, f.s, free});
                 } else {
-                    Segment s = whole;  // every ray enters an ungated root
-                    if (m.has_bv) s = clip_segment(seg_.inv[i], m.bv, s);
-                    out.push_back({i, s});
+                    Segment s = whole, full = line;  // every ray enters an ungated root
+                    if (m.has_bv) s = clip_segment(seg_.inv[i], m.bv, s), full = clip_segment(seg_.inv[i], m.bv, full);
+                    out.push_back({i, free ? full : s, full, free});
                 }
             }
             return !out.empty();
@@ -103,15 +178,50 @@ private:
         bool any = false;
         for (const Reach& r : by_depth_[depth - 1]) {
             if (r.s.empty()) continue;  // met the parent's region, not its bounding volume
-            const std::size_t before = out.size();
-            add(r.ray, r.s);
-            any |= out.size() > before;
+            if (!overlapping_) {
+                const Clipped c = clip(r.ray, r.s);
+                if (!c.met) continue;
+                out.push_back({r.ray, c.s, c.s, false});
+                any = true;
+                continue;
+            }
+            const Clipped f = clip(r.ray, r.full);
+            if (!f.met) continue;
+            if (r.free) {
+                out.push_back({r.ray, f.s, f.s, true});
+                any = true;
+                continue;
+            }
+            const Clipped c = clip(r.ray, r.s);
+            if (!on_hit_path(r.ray)) {
+                // Not where the hit lies: searched before the hit is known if entered before the
+                // ray's end (then on the whole ray), else never.
+                if (!c.met) continue;
+                out.push_back({r.ray, f.s, f.s, true});
+                any = true;
+                continue;
+            }
+            if (!c.met) continue;
+            out.push_back({r.ray, c.s, f.s, false});
+            any = true;
         }
         return any;
     }
 
+    /// Whether the node being asked holds the leaf where ray `i`'s closest hit is found.
+    bool on_hit_path(std::uint32_t i) const {
+        for (std::uint32_t k = ends_at_[i]; k < ends_at_[i + 1]; ++k)
+            if (end_leaves_[k] >= node_ && end_leaves_[k] < order_->end[node_]) return true;
+        return false;
+    }
+
     const RaySample& sample_;
+    const PreorderIndex* order_;
     bool one_path_ = false;
+    bool overlapping_ = false;
+    std::uint32_t node_ = 0, cursor_ = 0;  // BVH: the node asked, and the next one's pre-order index
+    std::vector<std::uint32_t> ends_at_;   // BVH: ray i's end leaves are end_leaves_[ends_at_[i], ends_at_[i + 1])
+    std::vector<std::uint32_t> end_leaves_;
     model::ReplaySegments seg_;
     std::vector<std::vector<Reach>> by_depth_;
     // 5D: each sample ray's point and cube; per depth, the rays in the node last kept there,
@@ -126,9 +236,13 @@ private:
     std::vector<ModelNode> parent_;
 };
 
-ModelTree reached_model_tree(const Hierarchy& h, const RaySample& sample) {
+ModelTree reached_model_tree(const Hierarchy& h, const Scene& scene, const RaySample& sample) {
     ModelTree t;
-    ReachCollector c(t, sample);
+    // A BVH is read twice: once for where each node and leaf lies (which nodes hold each ray's
+    // hit), then materialised.
+    PreorderIndex order(scene.size());
+    h.emit_model(order);
+    ReachCollector c(t, sample, order.read ? &order : nullptr);
     h.emit_model(c);
     return t;
 }
@@ -146,7 +260,7 @@ SegmentsPredictor::SegmentsPredictor(const Hierarchy& h, const Scene& scene, con
         nodes = st.interior + st.leaves;
     }
     whole_ = nodes <= kWholeNodesPerRay * std::max<std::size_t>(sample.size(), 1);
-    tree_ = whole_ ? h.model_tree() : reached_model_tree(h, sample);
+    tree_ = whole_ ? h.model_tree() : reached_model_tree(h, scene, sample);
     tree_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
