@@ -183,8 +183,14 @@ private:
             if (l && r) {
                 ty.both += 1;
                 // Nearer entry first, a tie (a ray starting inside both) to the first child; a
-                // BVH without order: stored order.
+                // BVH without order: stored order. A kd-tree's traversal takes the side the ray
+                // comes from first (by its direction), so a tie there goes to that side: a ray
+                // entering a cell split one float beside a face it hits (kd-sah's planes) meets
+                // both sides at once, and the thin side holding the face ends the search.
                 bool left_first = !t_.cull || sl.t0 <= sr.t0;
+                if (t_.cull && sl.t0 == sr.t0 && t_.family == ModelFamily::Kd && m.axis >= 0 && m.axis < 3 &&
+                    std::fabs(ri_.inv[m.axis]) < kInf)
+                    left_first = !ri_.neg[m.axis];
                 if (any_ && t_.any_leaves_first) {
                     const bool ll = t_.nodes[m.first].leaf, lr = t_.nodes[m.first + 1].leaf;
                     left_first = ll != lr ? ll : sl.t0 < sr.t0;
