@@ -34,9 +34,10 @@ public:
     std::vector<std::uint32_t> end;      ///< per node (pre-order): one past its subtree's last node
     std::vector<std::uint32_t> leaf_of;  ///< per primitive: its leaf (pre-order), ~0u if none
 
-    /// Read only for a BVH searched front to back (the emitter stops otherwise).
+    bool read = false;                   ///< whether the tree was read (a BVH searched front to back)
+
+    /// Reads only a BVH searched front to back (the emitter stops otherwise).
     bool begin(const ModelFlags& f) override { return read = f.family == ModelFamily::Bvh && f.cull; }
-    bool read = false;
     void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
         const auto k = static_cast<std::uint32_t>(end.size());
         end.push_back(k + 1);
@@ -187,22 +188,17 @@ private:
             }
             const Clipped f = clip(r.ray, r.full);
             if (!f.met) continue;
-            if (r.free) {
-                out.push_back({r.ray, f.s, f.s, true});
-                any = true;
-                continue;
+            bool free = r.free;
+            Segment s = f.s;
+            if (!free) {
+                const Clipped c = clip(r.ray, r.s);
+                if (!c.met) continue;  // entered only past the ray's end: never searched
+                // Off the path to the hit, a node entered before the ray's end may be searched
+                // before the hit is known: on the whole ray.
+                free = !on_hit_path(r.ray);
+                if (!free) s = c.s;
             }
-            const Clipped c = clip(r.ray, r.s);
-            if (!on_hit_path(r.ray)) {
-                // Not where the hit lies: searched before the hit is known if entered before the
-                // ray's end (then on the whole ray), else never.
-                if (!c.met) continue;
-                out.push_back({r.ray, f.s, f.s, true});
-                any = true;
-                continue;
-            }
-            if (!c.met) continue;
-            out.push_back({r.ray, c.s, f.s, false});
+            out.push_back({r.ray, s, f.s, free});
             any = true;
         }
         return any;
