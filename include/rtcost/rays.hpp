@@ -20,6 +20,9 @@ class Hierarchy;
 /// direction is not normalised: its component along the view axis is 1, so tmin = hither clips
 /// at the hither plane exactly.
 std::vector<Ray> camera_rays(const Camera& cam, int width, int height);
+/// `n` eye rays of the same camera through uniformly random points of its `width` x `height`
+/// image (the whole view, not its pixel centres); directions as camera_rays'.
+std::vector<Ray> view_rays(const Camera& cam, int width, int height, std::size_t n, std::uint64_t seed);
 
 /// `n` isotropic random lines through `box` under the invariant measure of lines (uniform
 /// direction on the sphere, then a uniform point on the box's projection perpendicular to it),

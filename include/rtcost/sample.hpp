@@ -76,15 +76,19 @@ void find_ends(RaySample& s, const Hierarchy& reference);
 
 /// A sample of the scene alone, for predictions without the user's rays (the geometric
 /// estimator under termination): `per_kind` rays standing for each of `kinds`, made from the
-/// geometry and the lights only, never from the camera. Eye, line and file rays are aimed rays
-/// from outside, their targets chosen half by primitive and half by area (aimed_rays). The
-/// others start where such rays first meet a surface, on the side they came from: shadow rays towards one of the scene's lights (cosine-
-/// weighted without lights), diffuse and ambient-occlusion rays cosine-weighted (the latter
-/// ao_length() long), reflection rays mirrored, refraction rays straight on. Ends are found
-/// with `reference`. Deterministic for a seed; `population` is 0 (no distribution behind it).
+/// scene's geometry, camera, lights and materials, never from a distribution's rays. Eye rays
+/// start at the scene's eye through uniform points of its view (view_rays); line and file rays
+/// are aimed rays from outside, their targets chosen half by primitive and half by area
+/// (aimed_rays). Reflection rays start where eye rays land on a material that reflects or
+/// transmits, refraction rays where it transmits (bent by its index); shadow rays (towards one
+/// of the lights), diffuse and ambient-occlusion rays (cosine-weighted, the latter ao_length()
+/// long) start where eye, reflection and refraction rays land. Ends are found with `reference`.
+/// Deterministic for a seed; `population` is 0 (no distribution behind it). `view`, when given,
+/// is the camera eye rays come from instead of the scene's (the same eye with the image shape a
+/// distribution traces, say).
 RaySample draw_visibility_sample(const Scene& scene, std::span<const RayKind> kinds, std::size_t per_kind,
                                  std::uint64_t seed, const Hierarchy& reference, Query query = Query::Closest,
-                                 Query occlusion = Query::Any);
+                                 Query occlusion = Query::Any, const Camera* view = nullptr);
 
 /// The rays of `all` that are not in the sample drawn from it with the same count and seed (the
 /// test rays disjoint from a sample), in their order. For a camera-based distribution, the rays

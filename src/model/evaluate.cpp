@@ -195,8 +195,9 @@ void split_half(RaySet& all, RaySet& train, std::size_t sample) {
 }
 
 constexpr const char* kVisibilityNote =
-    "P from the scene's own visibility: where rays aimed at the primitives from outside, and rays spawned where "
-    "they first meet a surface, end (no ray of the distribution traced)";
+    "P from the scene's own visibility: where eye rays through the scene camera's view (lines: rays aimed at the "
+    "primitives from outside), and rays spawned where they first meet a surface as the materials and lights say, "
+    "end (no ray of the distribution traced)";
 
 bool wants(const EvalOptions& opt, Estimator e) {
     return std::find(opt.estimators.begin(), opt.estimators.end(), e) != opt.estimators.end();
@@ -249,8 +250,15 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
             if (opt.on_step) opt.on_step("visibility sample");
             const auto start = std::chrono::steady_clock::now();
             auto reference = build_hierarchy(scene, "bvh-sah");
+            // The camera with the image shape the distribution gives it (--size): a view framed
+            // for a tall image and traced square misses more than the scene's own shape says.
+            Camera view = scene.camera;
+            if (test.image_width > 0 && test.image_pixels >= test.image_width) {
+                view.width = static_cast<int>(test.image_width);
+                view.height = static_cast<int>(test.image_pixels / test.image_width);
+            }
             visibility = draw_visibility_sample(scene, kinds, kVisibilityRays, opt.sample_seed, *reference, opt.query,
-                                                opt.occlusion);
+                                                opt.occlusion, &view);
             for (std::size_t i = 0; i < visibility->size(); ++i)
                 visibility_kinds[static_cast<int>(visibility->rays.kinds[i])].push_back(static_cast<std::uint32_t>(i));
             res.visibility_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

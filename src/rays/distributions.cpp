@@ -45,6 +45,23 @@ std::vector<Ray> camera_rays(const Camera& cam, int width, int height) {
     return rays;
 }
 
+std::vector<Ray> view_rays(const Camera& cam, int width, int height, std::size_t n, std::uint64_t seed) {
+    // camera_rays' mapping, at uniform points of the image instead of its pixel centres.
+    Vec3 fwd = normalize_double(cam.at - cam.from);
+    Vec3 right = normalize_double(cross(fwd, normalize_double(cam.up)));
+    Vec3 up = cross(right, fwd);
+    const double half = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0);
+    const double scale = height > 1 ? half / (0.5 * (height - 1)) : 0.0;
+    Rng rng(seed);
+    std::vector<Ray> rays;
+    rays.reserve(n);
+    for (std::size_t k = 0; k < n; ++k) {
+        const double u = (rng.uniform() - 0.5) * width * scale, v = (rng.uniform() - 0.5) * height * scale;
+        rays.push_back(Ray{cam.from, fwd + right * static_cast<float>(u) + up * static_cast<float>(v), cam.hither, kInf});
+    }
+    return rays;
+}
+
 std::vector<Ray> line_rays(const Box3& box, std::size_t n, std::uint64_t seed) {
     Rng rng(seed);
     std::vector<Ray> rays;
