@@ -21,7 +21,7 @@ class Hierarchy;
 /// at the hither plane exactly.
 std::vector<Ray> camera_rays(const Camera& cam, int width, int height);
 /// `n` eye rays of the same camera through uniformly random points of its `width` x `height`
-/// image (the whole view, not its pixel centres); directions as camera_rays'.
+/// image (between its outermost pixel centres, not at them); directions as camera_rays'.
 std::vector<Ray> view_rays(const Camera& cam, int width, int height, std::size_t n, std::uint64_t seed);
 
 /// `n` isotropic random lines through `box` under the invariant measure of lines (uniform

@@ -82,7 +82,9 @@ void find_ends(RaySample& s, const Hierarchy& reference);
 /// (aimed_rays). Reflection rays start where eye rays land on a material that reflects or
 /// transmits, refraction rays where it transmits (bent by its index); shadow rays (towards one
 /// of the lights), diffuse and ambient-occlusion rays (cosine-weighted, the latter ao_length()
-/// long) start where eye, reflection and refraction rays land. Ends are found with `reference`.
+/// long) start where eye rays land and, when reflection or refraction rays are among `kinds` (a
+/// ray tree), where each eye landing's first reflection and refraction land. A kind listed twice
+/// is drawn once. Ends are found with `reference`.
 /// Deterministic for a seed; `population` is 0 (no distribution behind it). `view`, when given,
 /// is the camera eye rays come from instead of the scene's (the same eye with the image shape a
 /// distribution traces, say).

@@ -189,8 +189,13 @@ void split_half(RaySet& all, RaySet& train, std::size_t sample) {
         RaySet& to = to_train ? train : keep;
         to.rays.push_back(all.rays[i]);
         to.kinds.push_back(all.kinds[i]);
+        if (!to_train && i < all.pixels.size()) keep.pixels.push_back(all.pixels[i]);
     }
     keep.described = all.described;
+    // The test rays keep the image they came through, a pixel per ray (the geometric estimator
+    // draws its eye rays through the same view).
+    keep.image_width = all.image_width;
+    keep.image_pixels = all.image_pixels;
     all = std::move(keep);
 }
 

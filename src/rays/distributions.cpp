@@ -56,7 +56,8 @@ std::vector<Ray> view_rays(const Camera& cam, int width, int height, std::size_t
     std::vector<Ray> rays;
     rays.reserve(n);
     for (std::size_t k = 0; k < n; ++k) {
-        const double u = (rng.uniform() - 0.5) * width * scale, v = (rng.uniform() - 0.5) * height * scale;
+        // Over the span of the pixel centres, as camera_rays covers it.
+        const double u = (rng.uniform() - 0.5) * (width - 1) * scale, v = (rng.uniform() - 0.5) * (height - 1) * scale;
         rays.push_back(Ray{cam.from, fwd + right * static_cast<float>(u) + up * static_cast<float>(v), cam.hither, kInf});
     }
     return rays;

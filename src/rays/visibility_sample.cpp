@@ -7,6 +7,7 @@
 // from a formula that assumes primitives scattered independently.
 #include <algorithm>
 #include <cmath>
+#include <optional>
 #include <oneapi/tbb/parallel_for.h>
 
 #include "rays/whitted_tracer.hpp"
@@ -33,7 +34,7 @@ std::vector<Ray> eye_rays(const Camera& cam, std::size_t n, std::uint64_t seed) 
     return view_rays(cam, std::max(cam.width, 1), std::max(cam.height, 1), n, seed);
 }
 
-/// Where a ray from outside first met the scene, as shading sees it.
+/// Where a ray first met the scene, as shading sees it.
 struct Landing {
     Vec3 p, dir, n;  // n faces the incoming ray
     bool front;      // the ray met the side the geometric normal points to
@@ -73,36 +74,68 @@ std::vector<Landing> landings(const Hierarchy& h, const Camera& cam, std::size_t
 
 bool from_outside(RayKind k) { return k == RayKind::Line || k == RayKind::Test || k == RayKind::File; }
 
+// What the Whitted tree spawns at a landing (whitted.cpp): transmitters reflect too.
+bool reflects(const Landing& l) { return l.m && (l.m->ks > 0 || l.m->t > 0); }
+bool transmits(const Landing& l) { return l.m && l.m->t > 0; }
+
+Ray reflected(const Landing& l, float eps) {
+    return Ray{l.p + l.n * eps, l.dir - l.n * (2 * dot(l.dir, l.n)), 0, kInf};
+}
+
+/// Bent by Snell's law as the tracer bends it; straight on where no material says how; none
+/// under total internal reflection.
+std::optional<Ray> refracted(const Landing& l, float eps) {
+    Ray r{l.p - l.n * eps, l.dir, 0, kInf};
+    if (!transmits(l)) return r;
+    const float ior = l.m->ior > 0 ? l.m->ior : 1.0f, eta = l.front ? 1 / ior : ior;
+    const float cos_i = -dot(l.dir, l.n), q = 1 - eta * eta * (1 - cos_i * cos_i);
+    if (q < 0) return std::nullopt;
+    r.d = normalize(l.dir * eta + l.n * (eta * cos_i - std::sqrt(q)));
+    return r;
+}
+
 }  // namespace
 
-RaySample draw_visibility_sample(const Scene& scene, std::span<const RayKind> kinds, std::size_t per_kind,
+RaySample draw_visibility_sample(const Scene& scene, std::span<const RayKind> kinds_asked, std::size_t per_kind,
                                  std::uint64_t seed, const Hierarchy& reference, Query query, Query occlusion,
                                  const Camera* view) {
-    const Camera& cam = view ? *view : scene.camera;
     if (per_kind == 0) throw InputError("--sample", 0, "a visibility sample needs at least one ray per kind");
+    const Camera& cam = view ? *view : scene.camera;
+    std::vector<RayKind> kinds;  // each kind once, in the order asked: its place gives its random stream
+    for (RayKind k : kinds_asked)
+        if (std::find(kinds.begin(), kinds.end(), k) == kinds.end()) kinds.push_back(k);
     RaySample s;
     s.seed = seed;
     s.distribution = "visibility of the scene";
     s.rays.described = "visibility sample";
     const bool secondary =
         std::any_of(kinds.begin(), kinds.end(), [](RayKind k) { return k != RayKind::Eye && !from_outside(k); });
+    const bool tree = std::any_of(kinds.begin(), kinds.end(),
+                                  [](RayKind k) { return k == RayKind::Reflection || k == RayKind::Refraction; });
     const std::vector<Landing> land = secondary ? landings(reference, cam, per_kind, seed) : std::vector<Landing>{};
     const float eps = spawn_offset(scene), ao = ao_length(scene);
+    // In a ray tree (reflection or refraction rays among the kinds), shadow, diffuse and
+    // ambient-occlusion rays start also where the first bounce of each eye landing lands, one
+    // bounce per reflection or refraction the tree would spawn there: shadow rays go from every
+    // hit, not only the eye rays'.
+    std::vector<Landing> bounced;
+    if (tree) {
+        std::vector<Ray> bounces;
+        for (const Landing& l : land) {
+            if (reflects(l)) bounces.push_back(reflected(l, eps));
+            if (transmits(l))
+                if (const std::optional<Ray> r = refracted(l, eps)) bounces.push_back(*r);
+        }
+        bounced = landings_of(reference, bounces);
+    }
     auto add = [&](const Ray& r, RayKind k) {
         s.rays.rays.push_back(r);
         s.rays.kinds.push_back(k);
         s.queries.push_back(is_occlusion(k) ? occlusion : query);
     };
-    // Reflection and refraction rays first: where they land, shadow, diffuse and ambient-occlusion
-    // rays start too, as they do in the Whitted tree (shadow rays from every hit, not only the
-    // eye rays'). Each kind keeps its own random stream, by its place in `kinds`.
-    std::vector<RayKind> order(kinds.begin(), kinds.end());
-    std::stable_partition(order.begin(), order.end(),
-                          [](RayKind k) { return k == RayKind::Reflection || k == RayKind::Refraction; });
-    std::vector<Landing> later;
-    for (RayKind k : order) {
-        const std::uint64_t stream = 1 + static_cast<std::uint64_t>(std::find(kinds.begin(), kinds.end(), k) - kinds.begin());
-        const std::size_t first = s.rays.rays.size();
+    for (std::size_t at = 0; at < kinds.size(); ++at) {
+        const RayKind k = kinds[at];
+        const std::uint64_t stream = at + 1;
         if (k == RayKind::Eye) {
             for (const Ray& r : eye_rays(cam, per_kind, seed + stream)) add(r, k);
             continue;
@@ -112,52 +145,41 @@ RaySample draw_visibility_sample(const Scene& scene, std::span<const RayKind> ki
             for (const Ray& r : outside_rays(scene, per_kind, seed + stream)) add(r, k);
             continue;
         }
-        // Reflection and refraction rays start where the material reflects or transmits, as the
-        // Whitted tree spawns them (transmitters reflect too); elsewhere if no landing does.
+        // Reflection and refraction rays start where the material reflects or transmits (every
+        // landing if none does); the other kinds at every landing, the bounces' included.
         std::vector<const Landing*> from;
         for (const Landing& l : land)
-            if (k == RayKind::Reflection ? l.m && (l.m->ks > 0 || l.m->t > 0)
-                                         : k == RayKind::Refraction ? l.m && l.m->t > 0 : true)
+            if (k == RayKind::Reflection ? reflects(l) : k == RayKind::Refraction ? transmits(l) : true)
                 from.push_back(&l);
         if (k != RayKind::Reflection && k != RayKind::Refraction)
-            for (const Landing& l : later) from.push_back(&l);
+            for (const Landing& l : bounced) from.push_back(&l);
         if (from.empty())
             for (const Landing& l : land) from.push_back(&l);
         // Shadow rays exist only where the light is in front of the surface: points that face
-        // away give none, so more points are tried (a bounded number).
+        // away give none, so more points are tried (a bounded number). Each try picks its
+        // landing at random: the pool may hold more landings than rays are made.
         std::size_t made = 0;
         for (std::size_t i = 0; made < per_kind && i < 8 * per_kind; ++i) {
-            const Landing& l = *from[i % from.size()];
             ItemRng rng(seed + 31 * stream, i);
-            const Vec3 up = l.p + l.n * eps;
-            Ray r{up, detail::cosine_direction(l.n, rng), 0, kInf};
+            const auto pick = static_cast<std::size_t>(rng.uniform() * static_cast<double>(from.size()));
+            const Landing& l = *from[std::min(pick, from.size() - 1)];
+            Ray r{l.p + l.n * eps, detail::cosine_direction(l.n, rng), 0, kInf};
             if (k == RayKind::Shadow && !scene.lights.empty()) {
                 // One light per point, in turn: the tree's rays go to each light alike.
-                r.d = scene.lights[i % scene.lights.size()].position - up;
+                r.d = scene.lights[i % scene.lights.size()].position - r.o;
                 r.tmax = 1;
                 if (!(dot(r.d, l.n) > 0)) continue;
             } else if (k == RayKind::AO) {
                 r.tmax = ao;
             } else if (k == RayKind::Reflection) {
-                r.d = l.dir - l.n * (2 * dot(l.dir, l.n));
+                r = reflected(l, eps);
             } else if (k == RayKind::Refraction) {
-                // Snell's law as the tracer bends them; straight on where no material says how.
-                r.o = l.p - l.n * eps;
-                r.d = l.dir;
-                if (l.m && l.m->t > 0) {
-                    const float ior = l.m->ior > 0 ? l.m->ior : 1.0f, eta = l.front ? 1 / ior : ior;
-                    const float cos_i = -dot(l.dir, l.n), q = 1 - eta * eta * (1 - cos_i * cos_i);
-                    if (q < 0) continue;  // total internal reflection: no refraction ray
-                    r.d = normalize(l.dir * eta + l.n * (eta * cos_i - std::sqrt(q)));
-                }
+                const std::optional<Ray> bent = refracted(l, eps);
+                if (!bent) continue;  // total internal reflection: no refraction ray
+                r = *bent;
             }
             add(r, k);
             ++made;
-        }
-        if (k == RayKind::Reflection || k == RayKind::Refraction) {
-            const std::vector<Ray> mine(s.rays.rays.begin() + static_cast<std::ptrdiff_t>(first), s.rays.rays.end());
-            const std::vector<Landing> got = landings_of(reference, mine);
-            later.insert(later.end(), got.begin(), got.end());
         }
     }
     s.population = 0;

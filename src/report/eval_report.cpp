@@ -36,8 +36,8 @@ json queries_json(const EvalResult& r) {
     return q;
 }
 
-/// Whether the headline prediction is known to be rough: the geometric estimator with early
-/// termination (docs/model-accuracy.md).
+/// Whether the headline prediction stands on rays the scene makes rather than the user's: the
+/// geometric estimator with early termination (docs/model-accuracy.md).
 bool rough(const EvalResult& r) { return r.estimators.front() == Estimator::Geometric && r.query != Query::All; }
 
 }  // namespace
@@ -152,12 +152,14 @@ std::string eval_header(const EvalResult& r) {
                        r.scene, r.primitives, r.test_rays, r.distribution, split, kinds, estimator_name(est),
                        preset_name(r.presets.front()), r.calibrated ? "ns (calibrated)" : "operations",
                        est == Estimator::Geometric && r.visibility_rays > 0
-                           ? fmt::format("; P from a visibility sample of the scene alone ({} rays, {:.2f} s)",
+                           ? fmt::format("; P from a visibility sample of the scene file alone (its camera, lights and "
+                                         "materials; {} rays, {:.2f} s)",
                                          r.visibility_rays, r.visibility_seconds)
                        : est == Estimator::Geometric
                            ? "; P of a hit in a region of several primitives by the Poisson form 1 - exp(-sum p_i)"
                            : "",
-                       rough(r) ? "; with early termination this estimator is a rough guide (docs/model-accuracy.md)"
+                       rough(r) ? "; it errs where your rays are not what the scene's camera and lights make "
+                                  "(docs/model-accuracy.md)"
                                 : "",
                        left_out);
 }
