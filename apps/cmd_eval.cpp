@@ -120,7 +120,7 @@ Subcommand setup_eval(CLI::App& parent, Common& common) {
         ->check(CLI::IsMember({"closest", "any"}))
         ->capture_default_str();
     eval->add_option("--estimator", a->estimator,
-                     "geometric (none of your rays: surface areas, and with early termination the scene's own visibility), sampled (a probe of training rays with real primitive "
+                     "geometric (none of your rays: surface areas, and with early termination the visibility of the scene file's camera, lights and materials), sampled (a probe of training rays with real primitive "
                      "tests), segments (a ray sample's ended segments: no primitive tests), a comma-separated list, "
                      "both (sampled,geometric) or all; the first is the headline")
         ->capture_default_str();

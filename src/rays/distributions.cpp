@@ -18,47 +18,47 @@ Vec3 normalize_double(Vec3 v) {
     return {static_cast<float>(v.x / l), static_cast<float>(v.y / l), static_cast<float>(v.z / l)};
 }
 
+/// A camera's image plane: the ray through image point (u, v), in pixels from the image's centre,
+/// has direction fwd + right u scale + up v scale (not normalised: its component along the view
+/// axis is 1).
+struct ImagePlane {
+    Vec3 fwd, right, up;
+    double scale;  // tangent of the angle one pixel spans at the centre
+    ImagePlane(const Camera& cam, int height) {
+        // Normalised in double: a short view vector or up vector underflows in float to NaN rays.
+        fwd = normalize_double(cam.at - cam.from);
+        right = normalize_double(cross(fwd, normalize_double(cam.up)));
+        up = cross(right, fwd);
+        // NFF: the angle spans from the centre of the top pixel row to the centre of the bottom one.
+        const double half = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0);
+        scale = height > 1 ? half / (0.5 * (height - 1)) : 0.0;
+    }
+    Vec3 direction(double u, double v) const {
+        return fwd + right * static_cast<float>(u * scale) + up * static_cast<float>(v * scale);
+    }
+};
+
 }  // namespace
 
 std::vector<Ray> camera_rays(const Camera& cam, int width, int height) {
-    // Normalised in double: a short view vector or up vector underflows in float to NaN rays.
-    Vec3 fwd = normalize_double(cam.at - cam.from);
-    Vec3 right = normalize_double(cross(fwd, normalize_double(cam.up)));
-    Vec3 up = cross(right, fwd);
-    // NFF: the angle spans from the centre of the top pixel row to the centre of the bottom one.
-    double half = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0);
-    double scale = height > 1 ? half / (0.5 * (height - 1)) : 0.0;
+    const ImagePlane plane(cam, height);
     std::vector<Ray> rays;
     rays.reserve(static_cast<std::size_t>(width) * height);
-    for (int j = 0; j < height; ++j) {
-        for (int i = 0; i < width; ++i) {
-            double u = (i + 0.5 - 0.5 * width) * scale;
-            double v = (0.5 * height - j - 0.5) * scale;
-            Ray r;
-            r.o = cam.from;
-            r.d = fwd + right * static_cast<float>(u) + up * static_cast<float>(v);
-            r.tmin = cam.hither;
-            r.tmax = kInf;
-            rays.push_back(r);
-        }
-    }
+    for (int j = 0; j < height; ++j)
+        for (int i = 0; i < width; ++i)
+            rays.push_back(Ray{cam.from, plane.direction(i + 0.5 - 0.5 * width, 0.5 * height - j - 0.5), cam.hither, kInf});
     return rays;
 }
 
 std::vector<Ray> view_rays(const Camera& cam, int width, int height, std::size_t n, std::uint64_t seed) {
-    // camera_rays' mapping, at uniform points of the image instead of its pixel centres.
-    Vec3 fwd = normalize_double(cam.at - cam.from);
-    Vec3 right = normalize_double(cross(fwd, normalize_double(cam.up)));
-    Vec3 up = cross(right, fwd);
-    const double half = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0);
-    const double scale = height > 1 ? half / (0.5 * (height - 1)) : 0.0;
+    const ImagePlane plane(cam, height);
     Rng rng(seed);
     std::vector<Ray> rays;
     rays.reserve(n);
     for (std::size_t k = 0; k < n; ++k) {
-        // Over the span of the pixel centres, as camera_rays covers it.
-        const double u = (rng.uniform() - 0.5) * (width - 1) * scale, v = (rng.uniform() - 0.5) * (height - 1) * scale;
-        rays.push_back(Ray{cam.from, fwd + right * static_cast<float>(u) + up * static_cast<float>(v), cam.hither, kInf});
+        // Uniform over the span of the pixel centres, as camera_rays covers it.
+        const double u = (rng.uniform() - 0.5) * (width - 1), v = (rng.uniform() - 0.5) * (height - 1);
+        rays.push_back(Ray{cam.from, plane.direction(u, v), cam.hither, kInf});
     }
     return rays;
 }

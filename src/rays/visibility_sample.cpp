@@ -6,7 +6,6 @@
 // visibility (closed surfaces, rays that start on them, occlusion near the start) rather than
 // from a formula that assumes primitives scattered independently.
 #include <algorithm>
-#include <cmath>
 #include <optional>
 #include <oneapi/tbb/parallel_for.h>
 
@@ -35,11 +34,7 @@ std::vector<Ray> eye_rays(const Camera& cam, std::size_t n, std::uint64_t seed) 
 }
 
 /// Where a ray first met the scene, as shading sees it.
-struct Landing {
-    Vec3 p, dir, n;  // n faces the incoming ray
-    bool front;      // the ray met the side the geometric normal points to
-    const Material* m;
-};
+using Landing = detail::Surface;
 
 /// Where `rays` first meet a surface, as shading sees it (misses left out), in their order.
 std::vector<Landing> landings_of(const Hierarchy& h, const std::vector<Ray>& rays) {
@@ -51,7 +46,7 @@ std::vector<Landing> landings_of(const Hierarchy& h, const std::vector<Ray>& ray
         h.closest(rays[i], hh);
         detail::Surface s;
         if (!tracer.surface(rays[i], hh, s)) return;
-        got[i] = {s.p, s.dir, s.n, s.front, s.m};
+        got[i] = s;
         hit[i] = 1;
     });
     std::vector<Landing> out;
@@ -78,19 +73,16 @@ bool from_outside(RayKind k) { return k == RayKind::Line || k == RayKind::Test |
 bool reflects(const Landing& l) { return l.m && (l.m->ks > 0 || l.m->t > 0); }
 bool transmits(const Landing& l) { return l.m && l.m->t > 0; }
 
-Ray reflected(const Landing& l, float eps) {
-    return Ray{l.p + l.n * eps, l.dir - l.n * (2 * dot(l.dir, l.n)), 0, kInf};
-}
+Ray reflected(const Landing& l, float eps) { return Ray{l.p + l.n * eps, detail::mirrored(l), 0, kInf}; }
 
-/// Bent by Snell's law as the tracer bends it; straight on where no material says how; none
-/// under total internal reflection.
+/// Bent as the tracer bends it; straight on where the material does not transmit; none under
+/// total internal reflection.
 std::optional<Ray> refracted(const Landing& l, float eps) {
     Ray r{l.p - l.n * eps, l.dir, 0, kInf};
     if (!transmits(l)) return r;
-    const float ior = l.m->ior > 0 ? l.m->ior : 1.0f, eta = l.front ? 1 / ior : ior;
-    const float cos_i = -dot(l.dir, l.n), q = 1 - eta * eta * (1 - cos_i * cos_i);
-    if (q < 0) return std::nullopt;
-    r.d = normalize(l.dir * eta + l.n * (eta * cos_i - std::sqrt(q)));
+    const std::optional<Vec3> d = detail::refracted(l);
+    if (!d) return std::nullopt;
+    r.d = *d;
     return r;
 }
 

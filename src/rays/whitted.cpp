@@ -57,7 +57,7 @@ Vec3 WhittedTracer::trace(const Ray& ray, RayKind kind, int depth, Recorder* rec
     const Material& m = *s.m;
 
     Vec3 color = m.color * (kAmbient * m.kd);
-    const Vec3 refl = s.dir - s.n * (2 * dot(s.dir, s.n));
+    const Vec3 refl = mirrored(s);
     for (const Light& light : scene_.lights) {
         // No shadow ray when the light is behind the surface as the ray sees it.
         Vec3 o = s.p + s.n * eps_;
@@ -86,17 +86,12 @@ Vec3 WhittedTracer::trace(const Ray& ray, RayKind kind, int depth, Recorder* rec
     float reflect_weight = m.ks;
     Vec3 refr;
     if (refract) {
-        // Entering through the side the geometric normal points to, leaving through the other.
-        float ior = m.ior > 0 ? m.ior : 1.0f;
-        float eta = s.front ? 1.0f / ior : ior;
-        float cos_i = -dot(s.dir, s.n);
-        float k = 1 - eta * eta * (1 - cos_i * cos_i);
-        if (k < 0) {  // total internal reflection: the transmitted part reflects
+        if (const std::optional<Vec3> d = refracted(s)) {
+            refr = *d;
+        } else {  // total internal reflection: the transmitted part reflects
             refract = false;
             reflect = true;
             reflect_weight += m.t;
-        } else {
-            refr = normalize(s.dir * eta + s.n * (eta * cos_i - std::sqrt(k)));
         }
     }
     if (reflect)

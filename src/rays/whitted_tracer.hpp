@@ -2,8 +2,10 @@
 // The Whitted recursion shared by the SPD ray tree (which records rays) and the renderer (which
 // keeps the colour): one code path, so the image shows exactly the rays that are counted.
 #include <algorithm>
+#include <cmath>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <vector>
 
 #include "rtcost/whitted.hpp"
@@ -59,6 +61,21 @@ private:
     float eps_;
     float light_scale_;
 };
+
+/// The mirror direction of the ray that met `s`.
+inline Vec3 mirrored(const Surface& s) { return s.dir - s.n * (2 * dot(s.dir, s.n)); }
+
+/// The direction the ray that met `s` takes through it by Snell's law (the material's index; 1
+/// if not positive), entering through the side the geometric normal points to and leaving
+/// through the other; none under total internal reflection.
+inline std::optional<Vec3> refracted(const Surface& s) {
+    const float ior = s.m->ior > 0 ? s.m->ior : 1.0f;
+    const float eta = s.front ? 1.0f / ior : ior;
+    const float cos_i = -dot(s.dir, s.n);
+    const float k = 1 - eta * eta * (1 - cos_i * cos_i);
+    if (k < 0) return std::nullopt;
+    return normalize(s.dir * eta + s.n * (eta * cos_i - std::sqrt(k)));
+}
 
 /// A cosine-weighted unit direction about unit `n`.
 Vec3 cosine_direction(Vec3 n, ItemRng& rng);

@@ -38,7 +38,7 @@ json queries_json(const EvalResult& r) {
 
 /// Whether the headline prediction stands on rays the scene makes rather than the user's: the
 /// geometric estimator with early termination (docs/model-accuracy.md).
-bool rough(const EvalResult& r) { return r.estimators.front() == Estimator::Geometric && r.query != Query::All; }
+bool from_scene_rays(const EvalResult& r) { return r.estimators.front() == Estimator::Geometric && r.query != Query::All; }
 
 }  // namespace
 
@@ -158,7 +158,7 @@ std::string eval_header(const EvalResult& r) {
                        : est == Estimator::Geometric
                            ? "; P of a hit in a region of several primitives by the Poisson form 1 - exp(-sum p_i)"
                            : "",
-                       rough(r) ? "; it errs where your rays are not what the scene's camera and lights make "
+                       from_scene_rays(r) ? "; it errs where your rays are not what the scene's camera and lights make "
                                   "(docs/model-accuracy.md)"
                                 : "",
                        left_out);
