@@ -22,12 +22,12 @@ struct CalibrateArgs {
     int repeat = 3;
     std::string out = "costs.json";
     std::vector<std::string> held_out;  ///< scenes measured and predicted, not fitted
-    std::string terms = "ops,steps,simd,cache";
+    std::string terms = "ops,steps,simd,cache,edges";
 };
 
-/// --terms: the operations always; steps, simd and cache as named.
+/// --terms: the operations always; steps, simd, cache and edges as named.
 TimeTerms parse_terms(const std::string& text) {
-    TimeTerms t{false, false, false};
+    TimeTerms t{false, false, false, false};
     bool ops = false;
     std::size_t start = 0;
     while (start <= text.size()) {
@@ -37,7 +37,8 @@ TimeTerms parse_terms(const std::string& text) {
         else if (w == "steps") t.steps = true;
         else if (w == "simd") t.simd = true;
         else if (w == "cache") t.cache = true;
-        else throw InputError("--terms", 0, "unknown term '" + w + "' (known: ops, steps, simd, cache)");
+        else if (w == "edges") t.edges = true;
+        else throw InputError("--terms", 0, "unknown term '" + w + "' (known: ops, steps, simd, cache, edges)");
         start = end + 1;
     }
     if (!ops) throw InputError("--terms", 0, "'ops' (the operations and the fixed cost per ray, always fitted) must be among the terms");
@@ -118,6 +119,7 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         fit["box_simd"] = c.costs.box_simd >= 0 ? json(c.costs.box_simd) : json(nullptr);
         fit["cache"] = terms.cache ? json(c.costs.cache) : json(nullptr);
         fit["cache_bytes"] = c.costs.cache_bytes;
+        fit["polygon_edge"] = terms.edges ? json(c.costs.polygon_edge) : json(nullptr);
         json runs = json::array();
         for (std::size_t i = 0; i < samples.size(); ++i)
             runs.push_back({{"run", samples[i].label}, {"measured_ns_per_ray", samples[i].ns_per_ray},
@@ -152,6 +154,9 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     if (terms.cache)
         fmt::print("  {:<10} {:.3f} (per step, per doubling of the structure beyond {})\n", "cache", c.costs.cache,
                    human_bytes(static_cast<std::uint64_t>(c.costs.cache_bytes)));
+    if (terms.edges)
+        fmt::print("  {:<10} {:.3f} (per edge a polygon test walks, polygons of 4+ vertices; timed, not fitted)\n",
+                   "edge", c.costs.polygon_edge);
     fmt::print("\n{:<36} {:>12} {:>12} {:>9}\n", "run", "measured ns", "fitted ns", "residual");
     for (std::size_t i = 0; i < samples.size(); ++i)
         fmt::print("{:<36} {:>12.1f} {:>12.1f} {:>+8.1f}%\n", samples[i].label, samples[i].ns_per_ray, c.predicted[i],
@@ -188,7 +193,8 @@ Subcommand setup_calibrate(CLI::App& parent, Common& common) {
     cmd->add_option("--terms", a->terms,
                     "time model: ops (operations and a fixed cost per ray, always), steps (ns per traversal step), "
                     "simd (box tests of SIMD node visits priced apart), cache (ns per step per doubling of the "
-                    "structure beyond the L2 cache)")
+                    "structure beyond the L2 cache), edges (ns per edge a polygon test walks, polygons of more "
+                    "than three vertices)")
         ->capture_default_str();
     cmd->add_option("--held-out", a->held_out, "scenes measured and predicted with the fitted costs, not fitted (repeatable)");
     add_common(cmd, common);

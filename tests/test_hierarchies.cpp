@@ -1,8 +1,11 @@
 // Every hierarchy against brute force (exactly the same t) and brute force against Embree, on
 // real scenes and hard rays; plus the structural and counting invariants of the shared interface.
+#include <cmath>
 #include <map>
+#include <numbers>
 #include <optional>
 
+#include "rtcost/model.hpp"
 #include "test_support.hpp"
 
 namespace rtcost::test {
@@ -259,6 +262,63 @@ TEST(BruteCounting, TestsEveryPrimitiveOnce) {
     EXPECT_EQ(c.prim[static_cast<int>(PrimKind::Polygon)], 1u);
     EXPECT_EQ(c.leaves, 1u);
     EXPECT_TRUE(hit.hit());
+}
+
+// A hexagon over a parallel quad and a triangle beside them: a polygon test walks every edge of
+// a polygon of more than three vertices whose plane the ray meets before its nearest hit so far.
+Scene hexagon_over_quad() {
+    Scene s;
+    std::vector<Vec3> hex;
+    for (int i = 0; i < 6; ++i) {
+        const double a = i * std::numbers::pi / 3;
+        hex.push_back({float(std::cos(a)), float(std::sin(a)), 0});
+    }
+    const std::vector<Vec3> quad{{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1}};
+    const std::vector<Vec3> tri{{3, 0, 0}, {4, 0, 0}, {3, 1, 0}};
+    s.add_polygon(hex, 0);
+    s.add_polygon(quad, 0);
+    s.add_polygon(tri, 0);
+    s.finalize();
+    return s;
+}
+
+TEST(PolygonEdges, CountedWhereThePolygonTestWalksThem) {
+    const Scene s = hexagon_over_quad();
+    ASSERT_EQ(s.size(), 3u);
+    EXPECT_EQ(s.edges_walked(0), 6u);
+    EXPECT_EQ(s.edges_walked(1), 4u);
+    EXPECT_EQ(s.edges_walked(2), 0u);  // a triangle: the watertight test, no edge walk
+    auto brute = build_hierarchy(s, "brute");
+    auto edges = [&](const Hierarchy& h, const Ray& r) {
+        RayCounters c;
+        Hit hit;
+        h.closest(r, hit, c);
+        return c.polygon_edges;
+    };
+    // Down through both: brute force tests in id order, the hexagon first (its plane at t = 1,
+    // 6 edges), then the quad, whose plane at t = 2 lies beyond that hit (none).
+    const Ray down{{0.1f, 0.2f, 1}, {0, 0, -1}, 0, kInf};
+    EXPECT_EQ(edges(*brute, down), 6u);
+    // Up, away from both planes; and along them (no plane met): no edge walked.
+    EXPECT_EQ(edges(*brute, Ray{{0.1f, 0.2f, 1}, {0, 0, 1}, 0, kInf}), 0u);
+    EXPECT_EQ(edges(*brute, Ray{{-5, 0.2f, 0.5f}, {1, 0, 0}, 0, kInf}), 0u);
+    // A ray that stops short of the quad's plane walks the hexagon's edges only.
+    EXPECT_EQ(edges(*brute, Ray{{2, 2, 1}, {0, 0, -1}, 0, 1.5f}), 6u);
+    // Every counted hierarchy tests the hexagon the ray hits (6 edges), and the quad before it
+    // at most (4 more); its hit is the hexagon.
+    for (const auto& [name, set] : registered_variants(kTestHits)) {
+        auto h = build_hierarchy(s, name, set);
+        if (!h->counted()) continue;
+        const std::uint64_t e = edges(*h, down);
+        EXPECT_TRUE(e == 6 || e == 10) << name << ": " << e << " edges";
+    }
+    // Counted per ray in the measured cost.
+    RayCounters c;
+    Hit hit;
+    c.rays = 0;
+    brute->closest(down, hit, c);
+    c.rays = 1;
+    EXPECT_DOUBLE_EQ(measured_cost(c).polygon_edges, 6.0);
 }
 
 TEST(Registry, UnknownHierarchyAndParametersAreClearErrors) {

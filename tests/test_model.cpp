@@ -351,15 +351,69 @@ TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
     EXPECT_NEAR(c.costs.per_ray, 20, 1e-5);
     EXPECT_NEAR(c.rms_relative, 0, 1e-9);
     // The same runs fitted by operations alone cannot explain them.
-    Calibration ops = calibrate(runs, {false, false, false}, 1 << 20);
+    Calibration ops = calibrate(runs, {false, false, false, false}, 1 << 20);
     EXPECT_GT(ops.rms_relative, 0.01);
     EXPECT_EQ(ops.costs.step, 0);
     EXPECT_LT(ops.costs.box_simd, 0);  // not fitted: priced as box
-    EXPECT_FALSE(ops.fitted[ops.fitted.size() - 3]);  // step
+    EXPECT_FALSE(ops.fitted[ops.fitted.size() - 4]);  // step
+    EXPECT_FALSE(ops.fitted.back());                  // polygon_edge
     // No SIMD structure among the runs: box_simd stays unfitted.
     for (auto& s : runs) s.structure.box_lanes = 1;
     for (auto& s : runs) s.ns_per_ray = truth.scalar(s.ops, s.structure);
     EXPECT_LT(calibrate(runs, {}, 1 << 20).costs.box_simd, 0);
+}
+
+TEST(Calibrate, PricesPolygonEdgesAtTheirTimedCostAndFitsTheRest) {
+    // Runs with polygons of many vertices (gears' 144-gons): their time is their tests' price plus
+    // an edge price the fit is handed (timed on the machine by default). The rest comes back
+    // exactly; a fit without the edges' term cannot explain the runs.
+    UnitCosts truth;
+    truth.box = 4; truth.plane = 0; truth.hop = 0; truth.classify = 0; truth.per_ray = 10;
+    truth.prim = {15, 11, 0, 0};
+    truth.polygon_edge = 1.5;
+    std::vector<CalibrationSample> runs;
+    for (int i = 0; i < 12; ++i) {
+        CalibrationSample s;
+        s.label = "run " + std::to_string(i);
+        s.ops.box = 10 + 3 * (i % 5);
+        s.ops.prim = {1.0 + i % 3, 2.0 + (i * 3) % 4, 0, 0};
+        // Some runs walk quads' edges only, others 144-gons' too.
+        s.ops.polygon_edges = 4 * s.ops.prim[1] + (i % 2) * 144.0 * (1 + i % 3);
+        s.ns_per_ray = truth.scalar(s.ops);
+        runs.push_back(s);
+    }
+    TimeTerms edges{false, false, false, true};
+    Calibration c = calibrate(runs, edges, 1 << 20, 1.5);
+    EXPECT_DOUBLE_EQ(c.costs.polygon_edge, 1.5);
+    EXPECT_TRUE(c.fitted.back());
+    EXPECT_NEAR(c.costs.box, 4, 1e-6);
+    EXPECT_NEAR(c.costs.prim[0], 15, 1e-6);
+    EXPECT_NEAR(c.costs.prim[1], 11, 1e-6);
+    EXPECT_NEAR(c.costs.per_ray, 10, 1e-5);
+    EXPECT_NEAR(c.rms_relative, 0, 1e-9);
+    // Priced back: a run's fitted time holds its edges.
+    EXPECT_NEAR(c.predicted[1], runs[1].ns_per_ray, 1e-6 * runs[1].ns_per_ray);
+    Calibration without = calibrate(runs, {false, false, false, false}, 1 << 20);
+    EXPECT_EQ(without.costs.polygon_edge, 0);
+    EXPECT_GT(without.rms_relative, 0.05);
+}
+
+TEST(UnitCosts, PricesPolygonEdgesAndReadsThemFromACostsFile) {
+    CostVector c;
+    c.prim[1] = 2;
+    c.polygon_edges = 150;
+    UnitCosts u;  // unit costs: an edge is not an operation of the paper's
+    EXPECT_DOUBLE_EQ(u.scalar(c), 2.0);
+    u.polygon_edge = 1.5;
+    EXPECT_DOUBLE_EQ(u.scalar(c), 2.0 + 225.0);
+    auto path = std::filesystem::temp_directory_path() / "rtcost_costs_edges.json";
+    {
+        std::ofstream(path) << R"({"unit": "ns", "box": 1, "polygon_edge": 2.25, "prim": {"polygon": 9}})";
+    }
+    const UnitCosts r = UnitCosts::read(path.string());
+    EXPECT_DOUBLE_EQ(r.polygon_edge, 2.25);
+    EXPECT_DOUBLE_EQ(r.scalar(c), 18.0 + 337.5);
+    std::filesystem::remove(path);
 }
 
 TEST(UnitCosts, TheTimeModelPricesSimdBoxTestsAndTheCacheByTheStructure) {

@@ -22,6 +22,9 @@ struct CostVector {
     double box = 0, plane = 0, hop = 0, classify = 0;
     std::array<double, kPrimKinds> prim{};
     double steps = 0, leaves = 0, empty_leaves = 0;
+    /// Edges walked by the tests of polygons of more than three vertices (RayCounters::
+    /// polygon_edges): not an operation of the paper's, priced by the time model alone.
+    double polygon_edges = 0;
 
     double prim_tests() const { return prim[0] + prim[1] + prim[2] + prim[3]; }
 };
@@ -46,6 +49,9 @@ struct UnitCosts {
     /// memory a step waits on once the structure no longer fits in the cache.
     double cache = 0;
     double cache_bytes = 1 << 20;  ///< the cache the calibrating machine's structures fit in (its L2)
+    /// Per edge of a polygon of more than three vertices tested (CostVector::polygon_edges),
+    /// besides the polygon test's own price: the crossing test walks every edge.
+    double polygon_edge = 0;
     bool calibrated = false;  ///< nanoseconds fitted by `rtcost calibrate`
 
     /// Operations, steps and the fixed cost (no structure known: box tests priced at `box`, no
@@ -57,9 +63,9 @@ struct UnitCosts {
     /// The cache term's factor: log2(bytes / cache_bytes), 0 for a structure that fits.
     double cache_doublings(std::uint64_t bytes) const;
     /// Reads a costs file (JSON `{"unit": "ns", "box": ns, "plane": ns, ..., "per_ray": ns,
-    /// "step": ns, "box_simd": ns, "cache": ns, "cache_bytes": bytes, "prim": {"triangle": ns,
-    /// ...}}`; the time model's terms are optional: `box_simd` then prices SIMD box tests as
-    /// `box`, `step` and `cache` are 0).
+    /// "step": ns, "box_simd": ns, "cache": ns, "cache_bytes": bytes, "polygon_edge": ns, "prim":
+    /// {"triangle": ns, ...}}`; the time model's terms are optional: `box_simd` then prices SIMD
+    /// box tests as `box`, `step`, `cache` and `polygon_edge` are 0).
     static UnitCosts read(const std::string& path);
     /// Typical nanoseconds per operation, built in: what the designed hierarchies minimise
     /// unless told otherwise, because operation counts alone trade box tests for primitive
@@ -84,12 +90,16 @@ struct TimeTerms {
     bool steps = true;  ///< UnitCosts::step
     bool simd = true;   ///< UnitCosts::box_simd (else SIMD box tests are priced as any box test)
     bool cache = true;  ///< UnitCosts::cache
+    /// UnitCosts::polygon_edge, timed on this machine's crossing test (not fitted: see
+    /// calibrate.cpp) and taken out of each run's time before the rest is fitted.
+    bool edges = true;
 };
 
 struct Calibration {
     UnitCosts costs;                ///< fitted ns per operation (calibrated = true)
     std::vector<double> predicted;  ///< fitted ns per ray for each sample
-    /// Unknowns (box, plane, hop, classify, prims..., per_ray, step, box_simd, cache) the data
+    /// Unknowns (box, plane, hop, classify, prims..., per_ray, step, box_simd, cache,
+    /// polygon_edge: the last, timed on polygons rather than fitted) the data
     /// determined.
     std::vector<bool> fitted;
     double rms_relative = 0;        ///< root mean square of (predicted - measured) / measured
@@ -100,8 +110,14 @@ struct Calibration {
 /// cost 0 and are reported as not fitted (box_simd: -1, priced as `box`). `cache_bytes`: the cache
 /// the cache term counts doublings beyond (0: this machine's L2). Throws InputError with fewer
 /// samples than fitted unknowns.
+/// `edge_ns`: the ns per polygon edge (terms.edges) when known, negative: timed here
+/// (polygon_edge_ns).
 Calibration calibrate(std::span<const CalibrationSample> samples, const TimeTerms& terms = {},
-                      double cache_bytes = 0);
+                      double cache_bytes = 0, double edge_ns = -1);
+
+/// Nanoseconds per edge of the polygon test's crossing loop on this machine, timed on regular
+/// polygons of 8 and 64 vertices (what calibrate prices UnitCosts::polygon_edge at).
+double polygon_edge_ns();
 
 /// This machine's L2 cache in bytes (1 MiB when the system does not say).
 double cache_size_bytes();

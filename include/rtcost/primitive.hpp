@@ -67,6 +67,9 @@ struct Hit {
 bool intersect(const Triangle& tri, const Ray& ray, float& t);
 /// Polygon test: plane hit, then a crossing-number inside test in the plane of projection.
 bool intersect(const Polygon& poly, std::span<const Vec3> pool, const Ray& ray, float& t);
+/// Edges the polygon test walks for `ray`: every one of a polygon of more than three vertices
+/// whose plane the ray meets in (tmin, tmax), else none (a triangle takes the watertight test).
+std::uint32_t edges_walked(const Polygon& poly, const Ray& ray);
 /// Sphere test, origin inside included (then the far root is returned).
 bool intersect(const Sphere& s, const Ray& ray, float& t);
 /// Open cone/cylinder test, origin inside included, no end caps.

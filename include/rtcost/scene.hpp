@@ -108,6 +108,19 @@ public:
     /// Every primitive's bounds, area and kind, by id, as of the last finalize() (empty before).
     const std::vector<PrimSummary>& summaries() const { return summaries_; }
     PrimKind kind(std::uint32_t id) const { return prims[id].kind; }
+    /// Edges a test of primitive `id` walks (RayCounters::polygon_edges): a polygon of more than
+    /// three vertices, by its crossing test, each of its edges; no other primitive any. With
+    /// `ray` (its tmax the nearest hit so far), only when the ray meets the polygon's plane in
+    /// (tmin, tmax): what the test does; without, the edges a test may walk (the model's count).
+    std::uint32_t edges_walked(std::uint32_t id) const {
+        if (prims[id].kind != PrimKind::Polygon) return 0;
+        const std::uint32_t n = polygons[prims[id].index].count;
+        return n > 3 ? n : 0;
+    }
+    std::uint32_t edges_walked(std::uint32_t id, const Ray& ray) const {
+        if (prims[id].kind != PrimKind::Polygon) return 0;
+        return rtcost::edges_walked(polygons[prims[id].index], ray);
+    }
 
     /// Exact intersection of primitive `id`; see primitive.hpp.
     inline bool intersect(std::uint32_t id, const Ray& ray, float& t) const {

@@ -28,6 +28,9 @@ struct RayCounters {
     std::uint64_t hop = 0;       ///< 3DDDA cell steps
     std::uint64_t classify = 0;  ///< compares while classifying a ray (5D)
     std::array<std::uint64_t, kPrimKinds> prim{};  ///< primitive tests by kind
+    /// Edges of the polygons of more than three vertices tested (their crossing test walks each
+    /// one): a 144-gon costs as much as twenty quads, which one price per polygon test hides.
+    std::uint64_t polygon_edges = 0;
     std::uint64_t steps = 0;         ///< N_TS: traversal steps (interior and leaf visits)
     std::uint64_t leaves = 0;        ///< N_ETS: leaves visited
     std::uint64_t empty_leaves = 0;  ///< N_EETS: empty leaves visited
@@ -39,6 +42,7 @@ struct RayCounters {
     RayCounters& operator+=(const RayCounters& o) {
         rays += o.rays; box += o.box; plane += o.plane; hop += o.hop; classify += o.classify;
         for (int k = 0; k < kPrimKinds; ++k) prim[k] += o.prim[k];
+        polygon_edges += o.polygon_edges;
         steps += o.steps; leaves += o.leaves; empty_leaves += o.empty_leaves;
         for (int d = 0; d < kMaxStatDepth; ++d) visits[d] += o.visits[d];
         return *this;
@@ -54,6 +58,8 @@ struct NoCount {
     void hop() {}
     void classify() {}
     void prim(PrimKind) {}
+    /// `n` polygon edges walked by a primitive test (RayCounters::polygon_edges).
+    void edges(std::uint32_t) {}
     /// An interior node visited at `depth` (one traversal step).
     void interior(int) {}
     /// A leaf visited at `depth` holding `n` primitive references (one traversal step).
@@ -69,6 +75,7 @@ struct Count {
     void hop() { ++c.hop; }
     void classify() { ++c.classify; }
     void prim(PrimKind k) { ++c.prim[static_cast<int>(k)]; }
+    void edges(std::uint32_t n) { c.polygon_edges += n; }
     void interior(int depth) {
         ++c.steps;
         ++c.visits[depth < kMaxStatDepth ? depth : kMaxStatDepth - 1];

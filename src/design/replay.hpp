@@ -25,7 +25,7 @@ namespace rtcost::designing {
 class SampleReplay {
 public:
     SampleReplay(const Scene& s, const RaySample& sample, const UnitCosts& costs)
-        : sample_(sample), costs_(costs), kinds_(s.size()) {
+        : scene_(s), sample_(sample), costs_(costs), kinds_(s.size()) {
         // The scene's records are far larger, and a replay looks up a kind for every reference
         // of every leaf it visits.
         for (std::uint32_t id = 0; id < s.size(); ++id) kinds_[id] = static_cast<std::uint8_t>(s.kind(id));
@@ -37,7 +37,7 @@ public:
         Count counting{counters};
         for (std::size_t i = 0; i < sample_.size(); ++i) {
             const std::span<const Crossing> known = sample_.crossings_of(i);
-            const KnownTest test{known, kinds_};
+            const KnownTest test{known, kinds_, scene_};
             const Ray& ray = sample_.rays.rays[i];
             Hit hit;
             switch (sample_.queries[i]) {
@@ -55,8 +55,15 @@ private:
     struct KnownTest {
         std::span<const Crossing> known;
         const std::vector<std::uint8_t>& kinds;
+        const Scene& scene;
         bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, Count& c) const {
-            c.prim(static_cast<PrimKind>(kinds[id]));
+            const auto kind = static_cast<PrimKind>(kinds[id]);
+            c.prim(kind);
+            if (kind == PrimKind::Polygon) {
+                Ray r = ray;
+                r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
+                c.edges(scene.edges_walked(id, r));
+            }
             return model::known_crossing_hit(known, id, ray, hit);
         }
         /// A traversal of a tree built only where the sample reaches (subdiv::CellOptions::
@@ -64,6 +71,7 @@ private:
         [[noreturn]] void unbuilt() const { throw model::PrunedNodeReached{}; }
     };
 
+    const Scene& scene_;
     const RaySample& sample_;
     UnitCosts costs_;
     std::vector<std::uint8_t> kinds_;

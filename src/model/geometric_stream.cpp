@@ -174,6 +174,7 @@ private:
                 const PrimSummary& g = sums_[id];
                 inside += crofton_area(scene_, id, g) * share_inside(g.bounds, o.visit);
                 S.c.prim[static_cast<int>(g.kind)] += pg;
+                S.c.polygon_edges += pg * scene_.edges_walked(id);
             }
             S.c.leaves += 1;
             if (m.count == 0) S.c.empty_leaves += 1;
@@ -261,15 +262,17 @@ private:
             for (std::uint32_t id : prims) around.extend(sums_[id].bounds);
             const double sa = surface(around);
             std::array<double, kPrimKinds> tests{};
-            double alive = 1;
+            double alive = 1, edges = 0;
             for (std::uint32_t id : prims) {
                 const PrimSummary& g = sums_[id];
                 tests[static_cast<int>(g.kind)] += alive;
+                edges += alive * scene_.edges_walked(id);
                 if (terminate_) alive *= 1 - (sa > 0 ? std::min(1.0, crofton_area(scene_, id, g) / sa) : 0.0);
                 else S.c.prim[static_cast<int>(g.kind)] += 1;
             }
             if (terminate_)
                 for (int k = 0; k < kPrimKinds; ++k) S.c.prim[k] += static_cast<float>(tests[k]);
+            S.c.polygon_edges += edges;
             S.c.leaves += 1;
             if (m.count == 0) S.c.empty_leaves += 1;
         } else {

@@ -45,7 +45,29 @@ struct ReplaySegments {
 /// The cost vector's scalar fields (its `prim` array aside), for sums field by field.
 inline constexpr double CostVector::*kCostFields[] = {&CostVector::box,      &CostVector::plane, &CostVector::hop,
                                                      &CostVector::classify, &CostVector::steps, &CostVector::leaves,
-                                                     &CostVector::empty_leaves};
+                                                     &CostVector::empty_leaves, &CostVector::polygon_edges};
+
+/// Whether any primitive's test walks polygon edges (Scene::edges_walked): where none does, the
+/// recursions skip counting them.
+inline bool walks_edges(const Scene& s) {
+    for (const Polygon& p : s.polygons)
+        if (p.count > 3) return true;
+    return false;
+}
+
+/// Polygon edges walked by a visit of leaf `m`: every primitive's test, or, where the model knows
+/// only the expected polygon tests per visit (`polygon_tests`, an ordered search that may stop),
+/// that many tests of the leaf's average polygon.
+inline double leaf_edges(const ModelTree& t, const ModelNode& m, const Scene& s, double polygon_tests = -1) {
+    double edges = 0, polygons = 0;
+    for (std::uint32_t k = 0; k < m.count; ++k) {
+        const std::uint32_t id = t.prims[m.first + k];
+        edges += s.edges_walked(id);
+        polygons += s.kind(id) == PrimKind::Polygon;
+    }
+    if (polygon_tests < 0) return edges;
+    return polygons > 0 ? polygon_tests * edges / polygons : 0.0;
+}
 
 // ---- Cauchy-Crofton geometry (crofton.cpp)
 Box3 intersect(const Box3& a, const Box3& b);

@@ -19,6 +19,7 @@ struct RayCostModel::Impl {
     std::vector<NodeProbabilities> prob;
     std::vector<int> parent;
     bool terminate = false;
+    bool walks = false;      // some primitive's test walks polygon edges (walks_edges)
     bool any_query = false;  // an any-hit query (its own child order where the tree declares one)
 
     // P that the search has ended in node x, where the recursion uses it: first of two met
@@ -48,9 +49,12 @@ struct RayCostModel::Impl {
             // A leaf no sampled ray reached has no learned test count: all its primitives.
             if (terminate && q.ordered && learned > 0) {
                 for (int k = 0; k < kPrimKinds; ++k) c.prim[k] += pg * q.tests[k];
+                const float polygons = q.tests[static_cast<int>(PrimKind::Polygon)];
+                if (walks && polygons > 0) c.polygon_edges += pg * leaf_edges(tree, m, *scene, polygons);
             } else {
                 for (std::uint32_t k = 0; k < m.count; ++k)
                     c.prim[static_cast<int>(scene->kind(tree.prims[m.first + k]))] += pg;
+                if (walks) c.polygon_edges += pg * leaf_edges(tree, m, *scene);
             }
             if (tree.locate)  // each cell is found by a descent from the root
                 for (int a = parent[node]; a >= 0; a = parent[a]) charge(c, tree.nodes[a], p, p);
@@ -92,6 +96,7 @@ RayCostModel::RayCostModel(ModelTree tree, const Scene& scene, const RaySample& 
     impl->any_query = opt.query == Query::Any;
     impl->tree = std::move(tree);
     impl->scene = &scene;
+    impl->walks = walks_edges(scene);
     for (const ModelNode& m : impl->tree.nodes)
         if (!m.leaf && m.count > 64)
             throw InputError("model", 0, "a node with more than 64 children has no per-ray prediction");

@@ -54,6 +54,7 @@ Prediction recurse(const ModelTree& t, const Walk& w, const std::vector<NodeProb
     int only = -1;
     for (int k = 0; k < kPrimKinds; ++k)
         if (counts[k] == scene.size() && scene.size() > 0) only = k;
+    const bool walks = walks_edges(scene);
     std::vector<std::uint8_t> kind;
     if (only < 0) {
         kind.resize(scene.size());
@@ -76,12 +77,15 @@ Prediction recurse(const ModelTree& t, const Walk& w, const std::vector<NodeProb
             if (m.count == 0) c.empty_leaves += p;
             if (terminate && q.ordered) {
                 for (int k = 0; k < kPrimKinds; ++k) c.prim[k] += pg * q.tests[k];
+                const float polygons = q.tests[static_cast<int>(PrimKind::Polygon)];
+                if (walks && polygons > 0) c.polygon_edges += pg * leaf_edges(t, m, scene, polygons);
             } else {
                 if (only >= 0) {
                     c.prim[only] += pg * m.count;
                 } else {
                     for (std::uint32_t k = 0; k < m.count; ++k) c.prim[kind[t.prims[m.first + k]]] += pg;
                 }
+                if (walks) c.polygon_edges += pg * leaf_edges(t, m, scene);
             }
             if (t.locate) {
                 // Every cell is found by a descent from the root: its ancestors' work again.

@@ -10,7 +10,8 @@
 namespace rtcost {
 
 double UnitCosts::scalar(const CostVector& c) const {
-    double s = per_ray + box * c.box + plane * c.plane + hop * c.hop + classify * c.classify + step * c.steps;
+    double s = per_ray + box * c.box + plane * c.plane + hop * c.hop + classify * c.classify + step * c.steps +
+               polygon_edge * c.polygon_edges;
     for (int k = 0; k < kPrimKinds; ++k) s += prim[k] * c.prim[k];
     return s;
 }
@@ -76,6 +77,7 @@ UnitCosts UnitCosts::read(const std::string& path) {
     if (j.contains("box_simd") && !j["box_simd"].is_null()) get(j, "box_simd", u.box_simd);
     get(j, "cache", u.cache);
     get(j, "cache_bytes", u.cache_bytes);
+    get(j, "polygon_edge", u.polygon_edge);
     if (j.contains("prim")) {
         for (int k = 0; k < kPrimKinds; ++k)
             get(j["prim"], std::string(prim_kind_name(static_cast<PrimKind>(k))).c_str(), u.prim[k]);
@@ -95,6 +97,7 @@ CostVector measured_cost(const RayCounters& c) {
     v.steps = c.steps / n;
     v.leaves = c.leaves / n;
     v.empty_leaves = c.empty_leaves / n;
+    v.polygon_edges = c.polygon_edges / n;
     return v;
 }
 

@@ -16,7 +16,8 @@ json cost_json(const CostVector& c, double scalar) {
     for (int k = 0; k < kPrimKinds; ++k) by_kind[std::string(prim_kind_name(static_cast<PrimKind>(k)))] = c.prim[k];
     return {{"cost", scalar},         {"box", c.box},   {"plane", c.plane},   {"hop", c.hop},
             {"classify", c.classify}, {"prim", c.prim_tests()}, {"prim_by_kind", by_kind},
-            {"N_TS", c.steps},        {"N_ETS", c.leaves}, {"N_EETS", c.empty_leaves}};
+            {"N_TS", c.steps},        {"N_ETS", c.leaves}, {"N_EETS", c.empty_leaves},
+            {"polygon_edges", c.polygon_edges}};
 }
 
 double relative(double predicted, double measured) { return measured > 0 ? (predicted - measured) / measured : 0.0; }

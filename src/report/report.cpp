@@ -53,6 +53,7 @@ nlohmann::json per_ray_json(const RayCounters& c) {
             {"classify", c.classify / n},
             {"prim", c.prim_tests() / n},
             {"prim_by_kind", by_kind},
+            {"polygon_edges", c.polygon_edges / n},
             {"visits_by_depth", visits}};
 }
 

@@ -114,6 +114,25 @@ bool setup_polygon(Polygon& poly, std::span<const Vec3> pool) {
 
 // Plane hit, then even-odd crossing test in the plane of projection that drops the normal's
 // largest axis; works for concave polygons (gear faces) as well as convex ones.
+namespace {
+// The polygon test's first step (shared with edges_walked, so that counting walks the same
+// arithmetic): where the ray meets the plane, and whether that lies in (tmin, tmax).
+bool plane_hit(const Polygon& poly, const Ray& ray, double& tt, float& tf) {
+    const D3 n = d3(poly.normal), o = d3(ray.o), d = d3(ray.d);
+    const double denom = dot(n, d);
+    if (denom == 0.0) return false;
+    tt = (static_cast<double>(poly.plane_d) - dot(n, o)) / denom;
+    tf = static_cast<float>(tt);
+    return tf > ray.tmin && tf < ray.tmax;
+}
+}  // namespace
+
+std::uint32_t edges_walked(const Polygon& poly, const Ray& ray) {
+    double tt;
+    float tf;
+    return poly.count > 3 && plane_hit(poly, ray, tt, tf) ? poly.count : 0;
+}
+
 bool intersect(const Polygon& poly, std::span<const Vec3> pool, const Ray& ray, float& t) {
     // A three-vertex polygon is a triangle: the watertight test is exact on shared edges whatever
     // the neighbours' projection planes, and faster than the crossing test in double.
@@ -121,13 +140,10 @@ bool intersect(const Polygon& poly, std::span<const Vec3> pool, const Ray& ray, 
         const Vec3* v = pool.data() + poly.first;
         return intersect(Triangle{v[0], v[1], v[2]}, ray, t);
     }
-    const D3 n = d3(poly.normal), o = d3(ray.o), d = d3(ray.d);
-    const double denom = dot(n, d);
-    if (denom == 0.0) return false;
-    const double tt = (static_cast<double>(poly.plane_d) - dot(n, o)) / denom;
-    const float tf = static_cast<float>(tt);
-    if (!(tf > ray.tmin && tf < ray.tmax)) return false;
-    const D3 p = o + d * tt;
+    double tt;
+    float tf;
+    if (!plane_hit(poly, ray, tt, tf)) return false;
+    const D3 p = d3(ray.o) + d3(ray.d) * tt;
     const int ia = (poly.drop_axis + 1) % 3, ib = (poly.drop_axis + 2) % 3;
     const double px = comp(p, ia), py = comp(p, ib);
     const Vec3* v = pool.data() + poly.first;

@@ -53,7 +53,8 @@ private:
 };
 
 /// Tests primitive `id` against `ray` and, when it is hit nearer than `hit.t`, records it.
-/// Counts one primitive test of the primitive's kind. Shared by every traversal's leaves.
+/// Counts one primitive test of the primitive's kind, and the edges a polygon's test walks.
+/// Shared by every traversal's leaves.
 /// Traversals implement Query::All by never terminating early or culling by `hit.t`
 /// (`if constexpr (Q != Query::All)` around every such test).
 template <class C>
@@ -61,6 +62,7 @@ inline bool test_prim(const Scene& scene, std::uint32_t id, const Ray& ray, Hit&
     counting.prim(scene.kind(id));
     Ray r = ray;
     r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
+    if constexpr (C::enabled) counting.edges(scene.edges_walked(id, r));
     float t;
     if (scene.intersect(id, r, t)) {
         hit.t = t;
