@@ -291,7 +291,7 @@ TEST(ModelSegments, AReachedBvhHoldsWhatTheReplayEntersBeforeItsHit) {
     const RaySample smp = draw_sample_from(s, cam, 60, 5, *ref);
     std::vector<std::uint32_t> idx(smp.size());
     for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
-    for (const char* name : {"bvh-sah", "bvh-median", "bvh-gs", "bvh-wide"}) {
+    for (const char* name : {"bvh-sah", "bvh-median", "bvh-gs", "bvh-wide", "bvh-design"}) {
         auto h = build_hierarchy(s, name);
         const ModelTree whole = h->model_tree();
         SegmentsPredictor predictor(*h, s, smp);
@@ -303,6 +303,58 @@ TEST(ModelSegments, AReachedBvhHoldsWhatTheReplayEntersBeforeItsHit) {
         EXPECT_DOUBLE_EQ(a.scalar, b.scalar) << name;
         EXPECT_DOUBLE_EQ(a.cost.box, b.cost.box) << name;
         EXPECT_DOUBLE_EQ(a.cost.prim_tests(), b.cost.prim_tests()) << name;
+    }
+}
+
+// The reached tree finds which BVH nodes hold a ray's hit from the runs of leaf-ordered
+// references the emitter offers (ModelSink::leaf_order), with no pass over the whole tree: each
+// subtree must hold exactly one run, a leaf's being its primitives, an interior node's its
+// children's side by side.
+TEST(ModelTree, EveryBvhOffersItsLeafOrderAsOneRunPerSubtree) {
+    struct Runs final : ModelSink {
+        std::span<const std::uint32_t> refs;
+        bool offered = false;
+        std::uint32_t lo = 0, hi = 0;
+        struct Open {
+            std::uint32_t hi, left, next;
+        };
+        std::vector<Open> open;
+        std::size_t nodes = 0, bad = 0;
+        bool begin(const ModelFlags&) override { return true; }
+        bool leaf_order(std::span<const std::uint32_t> r) override {
+            refs = r;
+            return offered = true;
+        }
+        void subtree(std::uint32_t l, std::uint32_t h) override { lo = l, hi = h; }
+        void node(const ModelNode& m, std::span<const std::uint32_t> prims) override {
+            ++nodes;
+            if (nodes == 1) bad += lo != 0 || hi != refs.size();
+            if (!open.empty()) {
+                bad += lo != open.back().next;
+                open.back().next = hi;
+                --open.back().left;
+            }
+            if (m.leaf) {
+                bad += prims.data() != refs.data() + lo || prims.size() != hi - lo;
+            } else {
+                open.push_back({hi, m.count, lo});
+                return;
+            }
+            while (!open.empty() && open.back().left == 0) {
+                bad += open.back().next != open.back().hi;
+                open.pop_back();
+            }
+        }
+    };
+    Scene s = builtin_scene("balls", 3);
+    for (const char* name : {"bvh-sah", "bvh-median", "bvh-gs", "bvh-design"}) {
+        auto h = build_hierarchy(s, name);
+        Runs runs;
+        h->emit_model(runs);
+        EXPECT_TRUE(runs.offered) << name;
+        EXPECT_EQ(runs.nodes, h->structure().interior + h->structure().leaves) << name;
+        EXPECT_EQ(runs.bad, 0u) << name;
+        EXPECT_TRUE(runs.open.empty()) << name;
     }
 }
 

@@ -146,6 +146,20 @@ public:
     /// that never asks emits every node, and a sink takes either. A ray sample reaches a small
     /// part of a large tree: reading the rest only to drop it cost more than the prediction.
     virtual bool skip_children() { return false; }
+    /// Offered by an emitter right after `begin` when each of its subtrees holds a contiguous
+    /// run of one array of primitive references (a BVH whose leaves lie in pre-order): `refs` is
+    /// that array. A sink that returns true is told each node's run by `subtree` just before the
+    /// node. (The segments estimator learns from it which nodes hold a ray's hit without a pass
+    /// over the whole tree.)
+    virtual bool leaf_order(std::span<const std::uint32_t> refs) {
+        (void)refs;
+        return false;
+    }
+    /// The run refs[lo, hi) of the node emitted next, after leaf_order returned true.
+    virtual void subtree(std::uint32_t lo, std::uint32_t hi) {
+        (void)lo;
+        (void)hi;
+    }
 };
 
 /// Emits a materialised model tree into `sink`, depth first (what Hierarchy::emit_model does

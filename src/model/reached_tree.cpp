@@ -67,9 +67,14 @@ private:
 /// the parent's bounding volume) clipped to the child's region.
 class ReachCollector final : public ModelCollector {
 public:
-    /// `order`: the tree's pre-order index (PreorderIndex) for a BVH, else null.
+    /// `order`: the tree's pre-order index (PreorderIndex) for a BVH whose emitter does not
+    /// offer its leaf order, else null.
     ReachCollector(ModelTree& t, const RaySample& sample, const PreorderIndex* order)
         : ModelCollector(t), sample_(sample), order_(order) {}
+
+    /// A BVH that neither offered its leaf order nor came with a pre-order index: nothing was
+    /// kept, and the tree is to be read again with one (reached_model_tree).
+    bool abandoned() const { return abandoned_; }
 
     bool begin(const ModelFlags& f) override {
         ModelCollector::begin(f);
@@ -78,32 +83,77 @@ public:
         // A BVH's children overlap: a closest-hit search enters a child met before the one that
         // holds its hit, and searches it whole (on the whole ray, no hit known yet), reaching
         // nodes beyond where the ray ends. Cells of a subdivision never overlap: a search past
-        // its end has stopped.
-        overlapping_ = f.family == ModelFamily::Bvh && f.cull && order_;
+        // its end has stopped. Which nodes hold a ray's hit is found from the leaf order the
+        // emitter offers (leaf_order), else from the pre-order index.
+        const bool bvh = f.family == ModelFamily::Bvh && f.cull;
+        overlapping_ = bvh && order_;
+        awaiting_ = bvh && !order_;
+        ranges_ = false;
         cursor_ = 0;
-        if (overlapping_) {
-            ends_at_.assign(sample_.size() + 1, 0);
-            end_leaves_.clear();
-            for (std::uint32_t i = 0; i < sample_.size(); ++i) {
-                // The leaves of the primitives found at the end (a tie keeps several): the
-                // nodes above them hold the hit.
-                if (seg_.ends[i] < sample_.rays.rays[i].tmax)
-                    for (const Crossing& c : sample_.crossings_of(i))
-                        if (c.t <= seg_.ends[i] && c.prim < order_->leaf_of.size())
-                            end_leaves_.push_back(order_->leaf_of[c.prim]);
-                ends_at_[i + 1] = static_cast<std::uint32_t>(end_leaves_.size());
-            }
-        }
+        if (overlapping_)
+            end_keys([&](std::uint32_t prim, auto&& add) {
+                if (prim < order_->leaf_of.size()) add(order_->leaf_of[prim]);
+            });
         return true;
     }
 
+    bool leaf_order(std::span<const std::uint32_t> refs) override {
+        if (!awaiting_) return false;
+        awaiting_ = false;
+        overlapping_ = ranges_ = true;
+        // Where each end primitive lies in refs: one pass over refs, looking up a bitmap of the
+        // primitives some ray ends at.
+        std::vector<std::uint32_t> wanted;
+        for (std::uint32_t i = 0; i < sample_.size(); ++i)
+            if (seg_.ends[i] < sample_.rays.rays[i].tmax)
+                for (const Crossing& c : sample_.crossings_of(i))
+                    if (c.t <= seg_.ends[i]) wanted.push_back(c.prim);
+        std::uint32_t top = 0;
+        for (std::uint32_t p : wanted) top = std::max(top, p + 1);
+        std::vector<bool> is_end(top, false);
+        for (std::uint32_t p : wanted) is_end[p] = true;
+        std::vector<std::pair<std::uint32_t, std::uint32_t>> at;  // (primitive, position in refs)
+        for (std::uint32_t k = 0; k < refs.size(); ++k)
+            if (refs[k] < top && is_end[refs[k]]) at.push_back({refs[k], k});
+        std::sort(at.begin(), at.end());
+        end_keys([&](std::uint32_t prim, auto&& add) {
+            auto it = std::lower_bound(at.begin(), at.end(), std::pair<std::uint32_t, std::uint32_t>{prim, 0});
+            for (; it != at.end() && it->first == prim; ++it) add(it->second);
+        });
+        return true;
+    }
+
+    void subtree(std::uint32_t lo, std::uint32_t hi) override {
+        lo_ = lo;
+        hi_ = hi;
+    }
+
 private:
+    /// Fills each ray's end keys (ends_at_, end_keys_): `key_of(prim, add)` calls add(key) for
+    /// each place of a primitive the ray's search ends at (a tie keeps several). The nodes
+    /// above those places hold the hit.
+    template <class KeyOf>
+    void end_keys(KeyOf&& key_of) {
+        ends_at_.assign(sample_.size() + 1, 0);
+        end_leaves_.clear();
+        for (std::uint32_t i = 0; i < sample_.size(); ++i) {
+            if (seg_.ends[i] < sample_.rays.rays[i].tmax)
+                for (const Crossing& c : sample_.crossings_of(i))
+                    if (c.t <= seg_.ends[i]) key_of(c.prim, [&](std::uint32_t key) { end_leaves_.push_back(key); });
+            ends_at_[i + 1] = static_cast<std::uint32_t>(end_leaves_.size());
+        }
+    }
+
     bool keep(const ModelNode& m, int depth) override {
+        if (awaiting_) {  // a BVH that did not offer its leaf order
+            abandoned_ = true;
+            return false;
+        }
         if (one_path_) return classify(m, depth);
         // This node's place in pre-order; the next one asked is past its subtree if it is dropped.
         node_ = cursor_;
         const bool kept = collect(m, depth);
-        if (overlapping_) cursor_ = kept ? node_ + 1 : order_->end.at(node_);
+        if (overlapping_ && !ranges_) cursor_ = kept ? node_ + 1 : order_->end.at(node_);
         return kept;
     }
 
@@ -206,8 +256,10 @@ private:
 
     /// Whether the node being asked holds the leaf where ray `i`'s closest hit is found.
     bool on_hit_path(std::uint32_t i) const {
+        // The node's run of refs (leaf order), or its pre-order subtree.
+        const std::uint32_t lo = ranges_ ? lo_ : node_, hi = ranges_ ? hi_ : order_->end[node_];
         for (std::uint32_t k = ends_at_[i]; k < ends_at_[i + 1]; ++k)
-            if (end_leaves_[k] >= node_ && end_leaves_[k] < order_->end[node_]) return true;
+            if (end_leaves_[k] >= lo && end_leaves_[k] < hi) return true;
         return false;
     }
 
@@ -215,9 +267,13 @@ private:
     const PreorderIndex* order_;
     bool one_path_ = false;
     bool overlapping_ = false;
+    bool awaiting_ = false;   // a BVH: its leaf order is expected before its first node
+    bool ranges_ = false;     // a BVH read with its leaf order: end keys are positions in refs
+    bool abandoned_ = false;
+    std::uint32_t lo_ = 0, hi_ = 0;  // the run of refs of the node asked (ranges_)
     std::uint32_t node_ = 0, cursor_ = 0;  // BVH: the node asked, and the next one's pre-order index
     std::vector<std::uint32_t> ends_at_;   // BVH: ray i's end leaves are end_leaves_[ends_at_[i], ends_at_[i + 1])
-    std::vector<std::uint32_t> end_leaves_;
+    std::vector<std::uint32_t> end_leaves_;  // BVH: each ray's end keys (leaf pre-order indices or refs positions)
     model::ReplaySegments seg_;
     std::vector<std::vector<Reach>> by_depth_;
     // 5D: each sample ray's point and cube; per depth, the rays in the node last kept there,
@@ -233,9 +289,15 @@ private:
 };
 
 ModelTree reached_model_tree(const Hierarchy& h, const Scene& scene, const RaySample& sample) {
+    {
+        ModelTree t;
+        ReachCollector c(t, sample, nullptr);
+        h.emit_model(c);
+        if (!c.abandoned()) return t;
+    }
+    // A BVH that does not offer its leaf order is read twice: once for where each node and
+    // leaf lies (which nodes hold each ray's hit), then materialised.
     ModelTree t;
-    // A BVH is read twice: once for where each node and leaf lies (which nodes hold each ray's
-    // hit), then materialised.
     PreorderIndex order(scene.size());
     h.emit_model(order);
     ReachCollector c(t, sample, order.read ? &order : nullptr);

@@ -171,15 +171,15 @@ void read_leaf(const std::byte* at, std::uint32_t ntri, std::uint32_t nother, st
     for (std::uint32_t k = 0; k < nother; ++k) ids.push_back(o[k].id);
 }
 
-/// The primitive ids of a leaf lane, read back from the arena.
+/// The primitive ids of a leaf lane, read back from the arena into `ids` (cleared first: one
+/// buffer serves a whole emission).
 template <int K>
-std::vector<std::uint32_t> leaf_ids(const BvhWide::Data& d, std::uint32_t child, std::uint32_t count) {
-    std::vector<std::uint32_t> ids;
+void leaf_ids(const BvhWide::Data& d, std::uint32_t child, std::uint32_t count, std::vector<std::uint32_t>& ids) {
+    ids.clear();
     const std::uint32_t ntri = count & 0xffffu, nother = count >> 16;
     const auto* at = reinterpret_cast<const std::byte*>(d.leaves.data() + (child & ~kLeaf));
     if (pack_lanes(K, ntri) == 4) read_leaf<4>(at, ntri, nother, ids);
     else read_leaf<K>(at, ntri, nother, ids);
-    return ids;
 }
 
 /// Depth-first walk over the lanes: `leaf(box, first, packed counts, depth)` and
@@ -273,12 +273,13 @@ bool BvhWide::emit_model(ModelSink& sink) const {
     root.leaf = false;
     sink.node(root, {});
     if (sink.skip_children()) return true;
+    std::vector<std::uint32_t> ids;
     with_nodes(*d_, [&](const auto& nodes) {
         walk_lanes(
             nodes,
             [&](const Box3& box, std::uint32_t child, std::uint32_t packed, int) {
-                const std::vector<std::uint32_t> ids =
-                    d_->tri_lanes == 8 ? leaf_ids<8>(*d_, child, packed) : leaf_ids<4>(*d_, child, packed);
+                if (d_->tri_lanes == 8) leaf_ids<8>(*d_, child, packed, ids);
+                else leaf_ids<4>(*d_, child, packed, ids);
                 ModelNode m;
                 m.region = m.bv = box;
                 m.has_bv = true;

@@ -29,8 +29,17 @@ bool Bvh::emit_model(ModelSink& sink) const {
     f.cull = ordered_;
     f.any_leaves_first = ordered_ && any_leaves_first_;
     if (!sink.begin(f) || d_.nodes.empty()) return true;
+    // Every builder lays leaves' references out depth first: a subtree's run of refs starts at
+    // its leftmost leaf and ends with its rightmost.
+    const bool runs = sink.leaf_order(d_.refs);
     auto emit = [&](auto&& self, std::uint32_t i) -> void {
         const Node& n = d_.nodes[i];
+        if (runs) {
+            std::uint32_t lo = i, hi = i;
+            while (!d_.nodes[lo].leaf) lo = d_.nodes[lo].index;
+            while (!d_.nodes[hi].leaf) hi = d_.nodes[hi].index + d_.nodes[hi].count - 1;
+            sink.subtree(d_.nodes[lo].index, d_.nodes[hi].index + d_.nodes[hi].count);
+        }
         ModelNode m;
         m.region = n.box;
         m.has_bv = true;

@@ -137,10 +137,7 @@ public:
             out.box = g.box;
             out.leaf = g.leaf;
             out.count = static_cast<std::uint32_t>(g.items.size());
-            if (g.leaf) {
-                out.index = static_cast<std::uint32_t>(d.refs.size());
-                d.refs.insert(d.refs.end(), g.items.begin(), g.items.end());
-            } else {
+            if (!g.leaf) {
                 out.index = static_cast<std::uint32_t>(d.nodes.size());
                 for (std::uint32_t c : g.items) {
                     order.push_back(c);
@@ -148,6 +145,19 @@ public:
                 }
             }
         }
+        // Leaves' references depth first, as every BVH builder lays them out, so that each
+        // subtree holds one contiguous run of them (ModelSink::leaf_order).
+        auto place = [&](auto&& self, std::uint32_t i) -> void {
+            Node& out = d.nodes[i];
+            if (out.leaf) {
+                const GNode& g = nodes_[order[i]];
+                out.index = static_cast<std::uint32_t>(d.refs.size());
+                d.refs.insert(d.refs.end(), g.items.begin(), g.items.end());
+                return;
+            }
+            for (std::uint32_t k = 0; k < out.count; ++k) self(self, out.index + k);
+        };
+        place(place, 0);
         return d;
     }
 
