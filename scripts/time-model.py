@@ -113,7 +113,7 @@ def main():
                 "half has a polygon of more than four vertices, and a fit over quads cannot tell an edge from "
                 "the rest of the test).\n\n"
                 "Until 2026-12-04 the time model had no edge term and priced a polygon test at one fitted ns "
-                "whatever its vertices: gears' 144-gons, about twenty quads' time each, were priced as quads. "
+                "whatever its vertices: gears' 144-gons (a test of one took 228 ns, of a quad 12 ns, on this machine) were priced as quads. "
                 "Held out, gears was predicted 50.2% off and ranked with rho 0.882; over the twelve scenes the "
                 "time model erred by 20.8% on average, with rho 0.950 at the median and 7 of 12 scenes at 0.95 "
                 "or more.\n\n")

@@ -39,6 +39,7 @@ struct PixelCost {
     std::uint32_t rays = 0;
     std::uint32_t box = 0, plane = 0, hop = 0, classify = 0, steps = 0;
     std::array<std::uint32_t, kPrimKinds> prim{};
+    std::uint32_t polygon_edges = 0;  ///< RayCounters::polygon_edges
     float ns = 0;  ///< measured traversal time (when asked for), timer overhead removed
 };
 

@@ -117,6 +117,8 @@ public:
         const std::uint32_t n = polygons[prims[id].index].count;
         return n > 3 ? n : 0;
     }
+    /// The most vertices of any polygon (0 without polygons; set by finalize).
+    std::uint32_t max_polygon_vertices() const { return max_polygon_vertices_; }
     std::uint32_t edges_walked(std::uint32_t id, const Ray& ray) const {
         if (prims[id].kind != PrimKind::Polygon) return 0;
         return rtcost::edges_walked(polygons[prims[id].index], ray);
@@ -154,6 +156,7 @@ private:
 
     Box3 bounds_;
     std::vector<PrimSummary> summaries_;
+    std::uint32_t max_polygon_vertices_ = 0;
 };
 
 }  // namespace rtcost

@@ -49,11 +49,7 @@ inline constexpr double CostVector::*kCostFields[] = {&CostVector::box,      &Co
 
 /// Whether any primitive's test walks polygon edges (Scene::edges_walked): where none does, the
 /// recursions skip counting them.
-inline bool walks_edges(const Scene& s) {
-    for (const Polygon& p : s.polygons)
-        if (p.count > 3) return true;
-    return false;
-}
+inline bool walks_edges(const Scene& s) { return s.max_polygon_vertices() > 3; }
 
 /// Polygon edges walked by a visit of leaf `m`: every primitive's test, or, where the model knows
 /// only the expected polygon tests per visit (`polygon_tests`, an ordered search that may stop),
@@ -100,10 +96,21 @@ struct NodeProbabilities {
     /// With `ordered`: expected primitive tests per visit of a leaf, by kind, when the search
     /// may stop inside it (5D candidates searched in order; an any-hit query's leaves).
     std::array<float, kPrimKinds> tests{};
+    /// A leaf: polygon edges walked per visit past its bounding volume, as the probe found them
+    /// (a polygon's edges where the ray met its plane before the hit so far); negative: not
+    /// learned (the recursion then charges every polygon's edges).
+    float edges = -1;
     bool ordered = false;
     bool split = false;  ///< alpha, beta, gamma hold for this two-child node
 };
-static_assert(sizeof(NodeProbabilities) == 56);
+static_assert(sizeof(NodeProbabilities) == 60);
+
+/// The edges a leaf visit walks: as the probe learned them (NodeProbabilities::edges), else
+/// those of every polygon tested (leaf_edges; `polygon_tests` as there).
+inline double visit_edges(const ModelTree& t, const ModelNode& m, const Scene& s, const NodeProbabilities& q,
+                          double polygon_tests = -1) {
+    return q.edges >= 0 ? q.edges : leaf_edges(t, m, s, polygon_tests);
+}
 
 /// The segments estimator's per-node probabilities from the sample's rays `rays` (indices),
 /// before the recursion (what predict_segments feeds it). Throws InputError for a 5D tree.

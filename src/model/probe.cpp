@@ -13,6 +13,14 @@ namespace rtcost::model {
 
 namespace {
 
+/// The ray as a primitive test sees it: cut at the nearest hit so far (test_prim), which
+/// decides whether a polygon's plane is met and its edges walked.
+Ray up_to_hit(const Ray& ray, const Hit& hit) {
+    Ray r = ray;
+    r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
+    return r;
+}
+
 /// How a probe learns what a primitive test would find: a real test (the sampled estimator), or
 /// a look-up in the ray's crossings known from its sample (the segments estimator: no
 /// intersection is computed, whatever the hierarchy).
@@ -53,6 +61,8 @@ Prediction predict_one_path(const ModelTree& t, const Walk& w, const Scene& scen
     const std::size_t n = t.nodes.size();
     std::vector<double> handed(n, 0.0);
     std::vector<std::array<double, kPrimKinds>> tests(n, std::array<double, kPrimKinds>{});
+    std::vector<double> edges(n, 0.0);
+    const bool walks = walks_edges(scene);
     const Box3& root = t.nodes[0].region;
     const bool terminate = terminates(t, opt.query);
     std::size_t met = 0;
@@ -85,6 +95,7 @@ Prediction predict_one_path(const ModelTree& t, const Walk& w, const Scene& scen
             const double stop = terminate ? search_stop(so, std::min(hit.t, ray.tmax), adk, t.stop_margin) : kInf;
             if (forward_start(scene.prim_bounds(id), k, neg, t.search_pad) > stop) break;
             tests[node][static_cast<int>(scene.kind(id))] += 1;
+            if (walks) edges[node] += scene.edges_walked(id, up_to_hit(ray, hit));
             if (oracle.test(id, ray, hit) && terminate && opt.query == Query::Any) break;
         }
         oracle.end();
@@ -95,6 +106,7 @@ Prediction predict_one_path(const ModelTree& t, const Walk& w, const Scene& scen
         if (m.leaf) {
             prob[i].ordered = true;
             for (int k = 0; k < kPrimKinds; ++k) prob[i].tests[k] = handed[i] > 0 ? tests[i][k] / handed[i] : 0.0;
+            prob[i].edges = handed[i] > 0 ? static_cast<float>(edges[i] / handed[i]) : -1.0f;
             continue;
         }
         for (std::uint32_t k = 0; k < m.count; ++k)
@@ -120,11 +132,12 @@ public:
         double ended = 0;                              // visits after which nothing beyond was searched
         double first = 0, first_ends = 0;              // visited first of two met; and that ended it
         std::array<double, kPrimKinds> tests{};        // primitive tests in a leaf's visits
+        double edges = 0;                              // polygon edges those tests walked
     };
 
     Probe(const ModelTree& t, const Scene& s, PrimOracle& oracle, Query q)
         : t_(t), s_(s), oracle_(oracle), any_(q == Query::Any), cull_(q == Query::Closest && t.cull),
-          tally_(t.nodes.size()) {}
+          walks_(walks_edges(s)), tally_(t.nodes.size()) {}
 
     /// One training ray; false when it misses the root.
     bool run(const Ray& ray) {
@@ -172,6 +185,7 @@ private:
             for (std::uint32_t k = 0; k < m.count; ++k) {
                 const std::uint32_t id = t_.prims[m.first + k];
                 ty.tests[static_cast<int>(s_.kind(id))] += 1;
+                if (walks_) ty.edges += s_.edges_walked(id, up_to_hit(*ray_, hit_));
                 if (oracle_.test(id, *ray_, hit_)) {
                     found_ = true;
                     if (any_) break;
@@ -232,6 +246,7 @@ private:
     const Scene& s_;
     PrimOracle& oracle_;
     const bool any_, cull_;
+    const bool walks_;  // some polygon's test walks edges (walks_edges)
     std::vector<Tally> tally_;
     const Ray* ray_ = nullptr;
     RayInv ri_{Ray{}};
@@ -274,6 +289,7 @@ std::vector<NodeProbabilities> probe_probabilities(const ModelTree& t, const Sce
             // Tests per visit: all of the leaf's, but an any-hit query stops at its first hit.
             q.ordered = true;
             for (int k = 0; k < kPrimKinds; ++k) q.tests[k] = ty.gated > 0 ? ty.tests[k] / ty.gated : 0.0;
+            q.edges = ty.gated > 0 ? static_cast<float>(ty.edges / ty.gated) : -1.0f;
             continue;
         }
         if (m.count == 2) {

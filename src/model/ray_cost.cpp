@@ -49,12 +49,11 @@ struct RayCostModel::Impl {
             // A leaf no sampled ray reached has no learned test count: all its primitives.
             if (terminate && q.ordered && learned > 0) {
                 for (int k = 0; k < kPrimKinds; ++k) c.prim[k] += pg * q.tests[k];
-                const float polygons = q.tests[static_cast<int>(PrimKind::Polygon)];
-                if (walks && polygons > 0) c.polygon_edges += pg * leaf_edges(tree, m, *scene, polygons);
+                if (walks) c.polygon_edges += pg * visit_edges(tree, m, *scene, q, q.tests[static_cast<int>(PrimKind::Polygon)]);
             } else {
                 for (std::uint32_t k = 0; k < m.count; ++k)
                     c.prim[static_cast<int>(scene->kind(tree.prims[m.first + k]))] += pg;
-                if (walks) c.polygon_edges += pg * leaf_edges(tree, m, *scene);
+                if (walks) c.polygon_edges += pg * visit_edges(tree, m, *scene, q);
             }
             if (tree.locate)  // each cell is found by a descent from the root
                 for (int a = parent[node]; a >= 0; a = parent[a]) charge(c, tree.nodes[a], p, p);

@@ -77,15 +77,14 @@ Prediction recurse(const ModelTree& t, const Walk& w, const std::vector<NodeProb
             if (m.count == 0) c.empty_leaves += p;
             if (terminate && q.ordered) {
                 for (int k = 0; k < kPrimKinds; ++k) c.prim[k] += pg * q.tests[k];
-                const float polygons = q.tests[static_cast<int>(PrimKind::Polygon)];
-                if (walks && polygons > 0) c.polygon_edges += pg * leaf_edges(t, m, scene, polygons);
+                if (walks) c.polygon_edges += pg * visit_edges(t, m, scene, q, q.tests[static_cast<int>(PrimKind::Polygon)]);
             } else {
                 if (only >= 0) {
                     c.prim[only] += pg * m.count;
                 } else {
                     for (std::uint32_t k = 0; k < m.count; ++k) c.prim[kind[t.prims[m.first + k]]] += pg;
                 }
-                if (walks) c.polygon_edges += pg * leaf_edges(t, m, scene);
+                if (walks) c.polygon_edges += pg * visit_edges(t, m, scene, q);
             }
             if (t.locate) {
                 // Every cell is found by a descent from the root: its ancestors' work again.

@@ -92,6 +92,7 @@ PixelCosts pixel_costs(const Hierarchy& h, const PixelCostOptions& opt) {
                 p.classify = narrow(c.classify);
                 p.steps = narrow(c.steps);
                 for (int k = 0; k < kPrimKinds; ++k) p.prim[k] = narrow(c.prim[k]);
+                p.polygon_edges = narrow(c.polygon_edges);
                 rows[j] += c;
                 if (opt.predict)
                     for (std::size_t r = 0; r < rec.rays.size(); ++r)
@@ -136,15 +137,16 @@ std::vector<double> heat_values(const PixelCosts& pc, HeatKind kind, const UnitC
             case HeatKind::Predicted: {
                 const CostVector& c = pc.predicted[i];
                 double s = costs.per_ray * p.rays + costs.box * c.box + costs.plane * c.plane + costs.hop * c.hop +
-                           costs.classify * c.classify;
+                           costs.classify * c.classify + costs.step * c.steps + costs.polygon_edge * c.polygon_edges;
                 for (int k = 0; k < kPrimKinds; ++k) s += costs.prim[k] * c.prim[k];
                 out[i] = s;
                 break;
             }
             case HeatKind::Ops: {
-                // UnitCosts::scalar of the summed operations plus the fixed cost of every ray.
+                // UnitCosts::scalar of the summed operations plus the fixed cost of every ray (the
+                // structure's terms, SIMD boxes and cache, aside: one structure per map).
                 double s = costs.per_ray * p.rays + costs.box * p.box + costs.plane * p.plane + costs.hop * p.hop +
-                           costs.classify * p.classify;
+                           costs.classify * p.classify + costs.step * p.steps + costs.polygon_edge * p.polygon_edges;
                 for (int k = 0; k < kPrimKinds; ++k) s += costs.prim[k] * p.prim[k];
                 out[i] = s;
                 break;

@@ -199,6 +199,8 @@ void Scene::finalize() {
         bounds_.extend(sums[id].bounds);
     }
     summaries_ = std::move(sums);
+    max_polygon_vertices_ = 0;
+    for (const Polygon& p : polygons) max_polygon_vertices_ = std::max(max_polygon_vertices_, p.count);
     if (materials.empty()) materials.push_back(Material{});
     if (empty()) return;
     Vec3 c = bounds_.center();
