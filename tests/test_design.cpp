@@ -110,8 +110,12 @@ TEST(Design, DesignsMinimiseTypicalTimeUnlessToldOtherwise) {
     const DesignInput typical = draw_design_input(s, Params(design_param_specs(), base));
     EXPECT_TRUE(typical.costs.calibrated);
     EXPECT_EQ(typical.costs.box, UnitCosts::typical().box);
-    // A polygon test costs several box tests: what operation counts alone leave out.
-    EXPECT_GT(typical.costs.prim[static_cast<int>(PrimKind::Polygon)], 4 * typical.costs.box);
+    // A quad's test, with its four edges, costs several box tests, and a step more than a box
+    // test: what operation counts alone leave out.
+    EXPECT_GT(typical.costs.prim[static_cast<int>(PrimKind::Polygon)] + 4 * typical.costs.polygon_edge,
+              3 * typical.costs.box);
+    EXPECT_GT(typical.costs.step, typical.costs.box);
+    EXPECT_GT(typical.costs.cache, 0);
     std::vector<std::string> unit = base;
     unit.push_back("costs=unit");
     const DesignInput counts = draw_design_input(s, Params(design_param_specs(), unit));

@@ -13,7 +13,7 @@
 namespace rtcost::designing {
 
 /// Of `trees`, the one predicted cheapest on the design sample, each priced by its own traversal
-/// of the sample (replay.hpp); a tie keeps the earlier.
+/// of the sample with its size's cache misses (SampleReplay::time); a tie keeps the earlier.
 template <class H>
 std::unique_ptr<Hierarchy> cheapest_on_sample(std::vector<std::unique_ptr<H>> trees, const Scene& s,
                                               const DesignInput& in) {
@@ -21,7 +21,7 @@ std::unique_ptr<Hierarchy> cheapest_on_sample(std::vector<std::unique_ptr<H>> tr
     std::size_t best = 0;
     double best_cost = kInf;
     for (std::size_t i = 0; i < trees.size(); ++i) {
-        const double c = replay.cost(*trees[i]);
+        const double c = replay.time(*trees[i]);
         if (c < best_cost) best = i, best_cost = c;
     }
     return std::move(trees[best]);

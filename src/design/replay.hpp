@@ -13,6 +13,7 @@
 
 #include "../model/model_internal.hpp"
 #include "rtcost/design.hpp"
+#include "rtcost/hierarchy.hpp"
 #include "rtcost/stats.hpp"
 
 namespace rtcost::designing {
@@ -31,8 +32,24 @@ public:
         for (std::uint32_t id = 0; id < s.size(); ++id) kinds_[id] = static_cast<std::uint8_t>(s.kind(id));
     }
 
+    /// The model's prediction of the sample's operations through `h`, priced (sample_cost's).
     template <class H>
     double cost(const H& h) const {
+        return costs_.scalar(counted(h));
+    }
+
+    /// The same with the time model's terms of the structure: the cache misses of its size and
+    /// its SIMD box tests (a costs file's cache and box_simd; built-in typical costs have both).
+    /// What a design compares built candidates by.
+    template <class H>
+    double time(const H& h) const {
+        const bool sized = costs_.cache > 0 || costs_.box_simd >= 0;
+        return costs_.scalar(counted(h), sized ? h.structure() : StructureStats{});
+    }
+
+private:
+    template <class H>
+    CostVector counted(const H& h) const {
         RayCounters counters;
         Count counting{counters};
         for (std::size_t i = 0; i < sample_.size(); ++i) {
@@ -47,10 +64,9 @@ public:
             }
         }
         counters.rays = sample_.size();
-        return costs_.scalar(measured_cost(counters));
+        return measured_cost(counters);
     }
 
-private:
     // The segments estimator's answer to a primitive test, counted.
     struct KnownTest {
         std::span<const Crossing> known;

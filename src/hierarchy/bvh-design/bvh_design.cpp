@@ -142,7 +142,8 @@ Designed build_design(const Scene& s, const DesignInput& in, const DesignOptions
     // Mean cost of a primitive test and of a binary node's visit (a step and two box tests), in the
     // costs' units.
     double prim_cost = 0;
-    for (std::uint32_t i = 0; i < s.size(); ++i) prim_cost += in.costs.prim[static_cast<int>(s.kind(i))];
+    for (std::uint32_t i = 0; i < s.size(); ++i)  // with every edge a polygon's test may walk
+        prim_cost += in.costs.prim[static_cast<int>(s.kind(i))] + in.costs.polygon_edge * s.edges_walked(i);
     prim_cost = s.size() ? prim_cost / s.size() : 1;
     const double trav_cost = in.costs.step + 2 * in.costs.box;
 
@@ -326,7 +327,7 @@ const Registration reg{
                  for (bool leaves : {false, true}) {
                      if (!(leaves ? try_leaves : try_near)) continue;
                      h->set_any_leaves_first(leaves);
-                     const double c = replay.cost(*h);
+                     const double c = replay.time(*h);
                      if (!best.h || c < best.cost) best = {h, leaves, c};
                  }
              }

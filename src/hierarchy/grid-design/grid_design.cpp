@@ -23,7 +23,7 @@ std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, 
         double c = kInf;
         if (cells <= max_cells) {
             const Grid g(s, r, assign, mailbox);
-            c = replay.cost(g);
+            c = replay.time(g);
         }
         seen[r] = c;
         return c;

@@ -9,29 +9,11 @@
 // termination, the model's cheapest on the sample is kept (design/cheaper.hpp).
 #include "../kd/kdtree.hpp"
 #include "design/cell_rays.hpp"
+#include "prune.hpp"
 #include "design/cheaper.hpp"
 
 namespace rtcost::kd {
 namespace {
-
-// kd-sah's cheapest plane for the node, kept when the model says the split pays.
-struct Designer {
-    SahOptions sah;
-    designing::CellRays cells;
-
-    Split choose(const std::vector<BuildRef>& refs, const Box3& cell) {
-        const Split sp = sah_plane(refs, cell, sah, true);
-        if (sp.axis < 0) return sp;
-        const int a = sp.axis;
-        std::size_t counts[2] = {0, 0};
-        for (const BuildRef& r : refs) {
-            counts[0] += r.box.lo[a] <= sp.pos;
-            counts[1] += r.box.hi[a] >= sp.pos;
-        }
-        const Box3 halves[2] = {spatial::half(cell, a, sp.pos, 0), spatial::half(cell, a, sp.pos, 1)};
-        return cells.split_pays(cell, refs.size(), halves, counts, 2) ? sp : Split{};
-    }
-};
 
 const Registration reg{
     {"kd-design",
@@ -57,21 +39,31 @@ const Registration reg{
          const SahOptions usual_sah;  // kd-sah's defaults
          std::vector<float> bonuses = {usual_sah.empty_bonus, 0.0f};
          if (!p.is("empty_bonus", "auto")) bonuses = {static_cast<float>(p.real("empty_bonus"))};
-         std::vector<std::unique_ptr<KdTree>> trees;  // a tie keeps the earlier: kd-sah's bonus first
-         for (float bonus : bonuses) {
-             // An interior visit of kd-sah's traversal: a step and one plane.
-             Designer d{{}, designing::CellRays(s, in, p.real("trust"), in.costs.step + in.costs.plane)};
-             d.sah.build = build;
-             d.sah.empty_bonus = bonus;
-             const Chooser choose = [&d](const std::vector<BuildRef>& refs, const Box3& cell, int) {
-                 return d.choose(refs, cell);
-             };
-             trees.push_back(std::make_unique<KdTree>(s, "kd-design", build_tree(s, d.sah.build, choose), p.flag("mailbox")));
-         }
          SahOptions usual = usual_sah;  // kd-sah's defaults, with this tree's depth and assignment
          usual.build = build;
          usual.build.max_prims = 1;
-         trees.push_back(std::make_unique<KdTree>(s, "kd-design", build_sah(s, usual), p.flag("mailbox")));
+         auto usual_tree = std::make_unique<KdTree>(s, "kd-design", build_sah(s, usual), p.flag("mailbox"));
+         // A node visit's price: a step, and with a calibrated time model the cache misses of a
+         // structure of the yardstick's size (the designed tree's own size is known only once
+         // built; a costs file without the time model's terms prices neither).
+         const double k_step = in.costs.step + in.costs.cache * in.costs.cache_doublings(usual_tree->structure().bytes);
+         std::vector<std::unique_ptr<KdTree>> trees;  // a tie keeps the earlier: kd-sah's bonus first
+         for (float bonus : bonuses) {
+             // An interior visit of kd-sah's traversal, beyond the step any visit takes: one plane.
+             const designing::CellRays cells(s, in, p.real("trust"), in.costs.plane, k_step);
+             // kd-sah's planes down to where even a cheap traversal (a quarter of a test) stops
+             // paying by the SAH, then the model's pruning.
+             SahOptions deep = usual_sah;
+             deep.build = build;
+             deep.c_trav = deep.c_isect / 4;
+             deep.empty_bonus = bonus;
+             const Chooser choose = [&deep](const std::vector<BuildRef>& refs, const Box3& cell, int) {
+                 return sah_plane(refs, cell, deep, false);
+             };
+             trees.push_back(std::make_unique<KdTree>(s, "kd-design", prune(build_tree(s, deep.build, choose), cells),
+                                                      p.flag("mailbox")));
+         }
+         trees.push_back(std::move(usual_tree));
          return designing::cheapest_on_sample(std::move(trees), s, in);
      },
      kLargeScene}};  // kd-sah's O(N log^2 N) planes, each judged on the sample: 19 s for a million triangles

@@ -30,7 +30,7 @@ template <class H>
 std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p, double planes, const char* name,
                                  int usual_depth, int usual_prims) {
     const DesignInput in = draw_design_input(s, p);
-    designing::CellRays cells(s, in, p.real("trust"), in.costs.step + planes * in.costs.plane);
+    designing::CellRays cells(s, in, p.real("trust"), planes * in.costs.plane, in.costs.step);
     subdiv::CellOptions o = subdiv::read_options(p);
     o.name = name;
     subdiv::CellOptions usual = o;
