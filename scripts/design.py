@@ -188,8 +188,9 @@ def main():
              "rays; `gain`: 1 - designed ns / yardstick ns; `build`: seconds, the designed one's including "
              "drawing its sample (the design time). The designs minimise "
              + (f"the ns per operation of `{a.costs}`" if a.costs else
-                "each family's default costs: typical ns per operation (rtcost's built-in `UnitCosts::typical`) "
-                "for bvh and kd, operation counts for grid, octree and bsp") + ".", "",
+                "each family's default costs: typical ns per operation (rtcost's built-in `UnitCosts::typical`, "
+                "the time model fitted on the twelve scenes of docs/time-model.md, with its step, cache and "
+                "polygon-edge terms) for bvh and kd, operation counts for grid, octree and bsp") + ".", "",
              "| scene | rays | family | sample | test rays | build s (design / yardstick) | predicted ops | measured ops | ns per ray | Embree ns | gain |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for scene, dist, doc, r in rows:
