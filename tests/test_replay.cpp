@@ -141,10 +141,11 @@ TEST(Replay, OfBvhsIsTheModelTreesPredictionAndTheTrace) {
 
 // kd-design's trees: kd-sah's with either empty bonus, and kd-median's. Not exactly the model
 // tree's prediction: the traversal widens each plane crossing against rounding (a ray within a
-// few ulps of a plane enters both sides, and a hit just past the plane can end the near side),
-// the model tree does not: within 0.1%, except gears' camera rays (0.4%: its central ray passes
-// through kd planes' intersections, where the model tree and the traversal part ways; not yet
-// pinned down). On closest-hit rays exactly the counted trace.
+// few ulps of a plane enters both sides), the model tree only where a hit just past the plane
+// ends the near side (the probe mirrors that since 2026-12-04: gears' camera rays were 0.4% off
+// before, on faces lying in kd planes): within 0.2% (0.13% of operations at most here, on
+// kd-median's node boxes: not pinned down). On closest-hit rays
+// exactly the counted trace.
 TEST(Replay, OfKdTreesIsTheModelTreesPredictionWithinRoundingAndTheTrace) {
     const int samples = for_each_sample(
         {"builtin:balls:2", "builtin:tetra:4", "gears"}, {"rays=camera", "rays=shadow", "rays=diffuse", "rays=spd"},
@@ -155,7 +156,7 @@ TEST(Replay, OfKdTreesIsTheModelTreesPredictionWithinRoundingAndTheTrace) {
                 const auto* kd = dynamic_cast<const kd::KdTree*>(h.get());
                 ASSERT_NE(kd, nullptr) << v.first;
                 const std::string what = where + " " + variant_name(v);
-                const double ops = expect_model(*kd, s, in, 0.005, what);
+                const double ops = expect_model(*kd, s, in, 2e-3, what);
                 if (where.ends_with("rays=camera")) {
                     EXPECT_NEAR(ops, traced_ops(*h, in.sample.rays.rays), 1e-9 * ops) << what;
                 }

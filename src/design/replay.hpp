@@ -11,6 +11,7 @@
 #include <span>
 #include <vector>
 
+#include "../hierarchy/common/impl.hpp"
 #include "../model/model_internal.hpp"
 #include "rtcost/design.hpp"
 #include "rtcost/hierarchy.hpp"
@@ -75,11 +76,7 @@ private:
         bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, Count& c) const {
             const auto kind = static_cast<PrimKind>(kinds[id]);
             c.prim(kind);
-            if (kind == PrimKind::Polygon) {
-                Ray r = ray;
-                r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
-                c.edges(scene.edges_walked(id, r));
-            }
+            if (kind == PrimKind::Polygon) c.edges(scene.edges_walked(id, up_to_hit(ray, hit)));
             return model::known_crossing_hit(known, id, ray, hit);
         }
         /// A traversal of a tree built only where the sample reaches (subdiv::CellOptions::

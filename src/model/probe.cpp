@@ -13,14 +13,6 @@ namespace rtcost::model {
 
 namespace {
 
-/// The ray as a primitive test sees it: cut at the nearest hit so far (test_prim), which
-/// decides whether a polygon's plane is met and its edges walked.
-Ray up_to_hit(const Ray& ray, const Hit& hit) {
-    Ray r = ray;
-    r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
-    return r;
-}
-
 /// How a probe learns what a primitive test would find: a real test (the sampled estimator), or
 /// a look-up in the ray's crossings known from its sample (the segments estimator: no
 /// intersection is computed, whatever the hierarchy).
@@ -214,7 +206,16 @@ private:
                 const Segment& far = left_first ? sr : sl;
                 tally_[near].first += 1;
                 visit(near, left_first ? sl : sr);
-                const bool ends = done() || beyond(far);
+                bool ends = done() || beyond(far);
+                // A kd-tree's traversal widens the near side's end by a relative 4e-7 against
+                // rounding (kd::KdTree), so a hit that far past the plane (a face lying in it)
+                // ends the search before the far side. Not for a ray in the plane: both sides
+                // then cover the same stretch, and the traversal searches both.
+                if (!ends && cull_ && t_.family == ModelFamily::Kd && m.axis >= 0 && m.axis < 3 &&
+                    std::fabs(ri_.inv[m.axis]) < kInf) {
+                    const float t1 = (left_first ? sl : sr).t1;
+                    ends = hit_.t <= t1 * (t1 > 0 ? 1.0000004f : 0.9999996f);
+                }
                 tally_[near].first_ends += ends;
                 if (!ends) visit(left_first ? m.first + 1 : m.first, far);
             } else if (l) {

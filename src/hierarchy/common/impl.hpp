@@ -52,6 +52,14 @@ private:
     const Derived& self() const { return static_cast<const Derived&>(*this); }
 };
 
+/// The ray as a primitive test sees it: cut at the nearest hit so far, which decides whether the
+/// test finds a hit and whether it meets a polygon's plane and walks its edges.
+inline Ray up_to_hit(const Ray& ray, const Hit& hit) {
+    Ray r = ray;
+    r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
+    return r;
+}
+
 /// Tests primitive `id` against `ray` and, when it is hit nearer than `hit.t`, records it.
 /// Counts one primitive test of the primitive's kind, and the edges a polygon's test walks.
 /// Shared by every traversal's leaves.
@@ -60,8 +68,7 @@ private:
 template <class C>
 inline bool test_prim(const Scene& scene, std::uint32_t id, const Ray& ray, Hit& hit, C& counting) {
     counting.prim(scene.kind(id));
-    Ray r = ray;
-    r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
+    const Ray r = up_to_hit(ray, hit);
     if constexpr (C::enabled) counting.edges(scene.edges_walked(id, r));
     float t;
     if (scene.intersect(id, r, t)) {
@@ -96,10 +103,8 @@ struct CrossingCollector {
     template <class C>
     bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, C&) const {
         if (kept(id)) return false;
-        Ray r = ray;
-        r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
         float t;
-        return scene.intersect(id, r, t) && insert(id, t, hit);
+        return scene.intersect(id, up_to_hit(ray, hit), t) && insert(id, t, hit);
     }
     /// Keeps primitive `id`, met at `t` (nearer than `hit.t`) by a traversal's own exact test
     /// (bvh: its triangle copies), unless kept already; true when `hit` then holds the
