@@ -1,12 +1,16 @@
-// `kd-design`: kd-sah's planes with the model's termination. A node stays a leaf when the cost
-// model, with visit probabilities from the design sample (the share of the node's sample
-// segments, clipped where each ray's search ends, that meet each child cell, blended with the
-// surface-area ratio where few reach the node), says splitting it does not pay: Subramanian and
-// Fussell's automatic termination with the user's rays instead of isotropic lines. kd-sah's plane
-// choice has one free constant that the sample can decide, the bonus of a split that cuts off
-// empty space: by default the tree is designed with no bonus and with kd-sah's 0.2 (a sweep of
-// kd-sah found either one best depending on the scene), and of the two, and of kd-sah's own
-// termination, the model's cheapest on the sample is kept (design/cheaper.hpp).
+// `kd-design`: kd-sah's planes with the model's termination. kd-sah's planes are laid down to
+// where even a traversal priced at a quarter of a test stops paying by the SAH, then judged
+// bottom up (prune.hpp): a subtree stays only where the cost model, with visit probabilities from
+// the design sample (the share of a node's sample segments, clipped where each ray's search
+// ends, that meet each child cell, blended with the surface-area ratio where few reach the
+// node), prices it below one leaf of its references -- Subramanian and Fussell's automatic
+// termination with the user's rays instead of isotropic lines, judged with every level below
+// known (a one-level test stops above splits that pay only further down). kd-sah's plane choice
+// has one free constant that the sample can decide, the bonus of a split that cuts off empty
+// space: by default the tree is designed with no bonus and with kd-sah's 0.2 (a sweep of kd-sah
+// found either one best depending on the scene), and of the two, and of kd-sah's own
+// termination, the model's cheapest on the sample, its size's cache misses included, is kept
+// (design/cheaper.hpp).
 #include "../kd/kdtree.hpp"
 #include "design/cell_rays.hpp"
 #include "prune.hpp"
@@ -17,7 +21,7 @@ namespace {
 
 const Registration reg{
     {"kd-design",
-     "kd-sah's planes, terminated where the cost model with a sample of the given rays says a split does not pay",
+     "kd-sah's planes, each subtree kept only where the cost model with a sample of the given rays prices it below one leaf",
      [] {
          std::vector<ParamSpec> p = design_param_specs();
          p.push_back(kMaxDepthParam);
