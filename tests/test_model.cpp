@@ -363,6 +363,33 @@ TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
     EXPECT_LT(calibrate(runs, {}, 1 << 20).costs.box_simd, 0);
 }
 
+TEST(Calibrate, AKindTheRunsCannotTellFromAnotherIsNotPricedAtZero) {
+    // Spheres only ever tested beside as many cones (as in tree.nff): the runs fix their sum, not
+    // each. NNLS alone may price one of them at 0; the fit then pulls the kinds toward their mean.
+    UnitCosts truth;
+    truth.box = 4; truth.plane = 0; truth.hop = 0; truth.classify = 0; truth.per_ray = 10;
+    truth.prim = {10, 0, 6, 20};
+    std::vector<CalibrationSample> runs;
+    for (int i = 0; i < 12; ++i) {
+        CalibrationSample s;
+        s.label = "run " + std::to_string(i);
+        s.ops.box = 6 + 5 * (i % 4);
+        const double paired = (i * 3) % 5;
+        s.ops.prim = {1.0 + i % 3, 0, paired, paired};
+        s.ns_per_ray = truth.scalar(s.ops);
+        runs.push_back(s);
+    }
+    TimeTerms ops_only;
+    ops_only.steps = ops_only.simd = ops_only.cache = ops_only.edges = false;
+    const Calibration c = calibrate(runs, ops_only);
+    const double sphere = c.costs.prim[2], cone = c.costs.prim[3];
+    EXPECT_GT(sphere, 1);
+    EXPECT_GT(cone, 1);
+    EXPECT_NEAR(sphere + cone, 26, 0.05);  // what the runs do fix
+    EXPECT_NEAR(c.costs.prim[0], 10, 0.3);  // a kind the runs fix moves by a few percent at most
+    EXPECT_LT(c.rms_relative, 0.01);
+}
+
 TEST(Calibrate, PricesPolygonEdgesAtTheirTimedCostAndFitsTheRest) {
     // Runs with polygons of many vertices (gears' 144-gons): their time is their tests' price plus
     // an edge price the fit is handed (timed on the machine by default). The rest comes back

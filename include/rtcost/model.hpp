@@ -108,8 +108,10 @@ struct Calibration {
 /// Non-negative least squares of ns_per_ray = UnitCosts::scalar(ops, structure), each sample
 /// weighted by 1 / ns_per_ray (relative errors count alike). Kinds that no sample performs keep
 /// cost 0 and are reported as not fitted (box_simd: -1, priced as `box`). `cache_bytes`: the cache
-/// the cache term counts doublings beyond (0: this machine's L2). Throws InputError with fewer
-/// samples than fitted unknowns.
+/// the cache term counts doublings beyond (0: this machine's L2). A primitive kind the samples
+/// test but the fit prices at 0 (one the samples cannot tell from another) is fitted again with
+/// every primitive price weakly pulled toward their mean. Throws InputError with fewer samples
+/// than fitted unknowns.
 /// `edge_ns`: the ns per polygon edge (terms.edges) when known, negative: timed here
 /// (polygon_edge_ns).
 Calibration calibrate(std::span<const CalibrationSample> samples, const TimeTerms& terms = {},
