@@ -3,6 +3,7 @@
 
 #include <algorithm>
 #include <iterator>
+#include <stdexcept>
 
 namespace rtcost::kd {
 namespace {
@@ -15,6 +16,7 @@ public:
         KdData out;
         out.root = t_.root;
         if (t_.nodes.empty()) return out;
+        if (!t_.boxes.empty()) throw std::logic_error("kd::prune: a tree with node boxes (kd-median's)");
         const std::vector<std::uint32_t> rays = cells_.meeting(nullptr, t_.root);
         std::vector<std::uint32_t> refs;
         judge(0, t_.root, rays, refs);

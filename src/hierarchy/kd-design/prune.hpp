@@ -10,7 +10,8 @@
 namespace rtcost::kd {
 
 /// `tree` with every subtree that the model prices above a leaf of its references made that
-/// leaf (each reference once, in id order).
+/// leaf (each reference once, in id order). For kd-sah's trees: node boxes (kd-median's
+/// KdData::boxes) are not carried over.
 KdData prune(const KdData& tree, const designing::CellRays& cells);
 
 }  // namespace rtcost::kd
