@@ -108,9 +108,11 @@ struct Calibration {
 /// Non-negative least squares of ns_per_ray = UnitCosts::scalar(ops, structure), each sample
 /// weighted by 1 / ns_per_ray (relative errors count alike). Kinds that no sample performs keep
 /// cost 0 and are reported as not fitted (box_simd: -1, priced as `box`). `cache_bytes`: the cache
-/// the cache term counts doublings beyond (0: this machine's L2). A primitive kind the samples
-/// test but the fit prices at 0 (one the samples cannot tell from another) is fitted again with
-/// every primitive price weakly pulled toward their mean. Throws InputError with fewer samples
+/// the cache term counts doublings beyond (0: this machine's L2). The primitive prices are then
+/// fitted again, each pulled toward the mean of the kinds tested with the weight of the first
+/// fit's rms relative residual (runs that a time model explains exactly are not moved; a price
+/// noisy runs fix poorly stays near the others), and at least weakly when the first fit priced a
+/// tested kind at 0 (one the samples cannot tell from another). Throws InputError with fewer samples
 /// than fitted unknowns.
 /// `edge_ns`: the ns per polygon edge (terms.edges) when known, negative: timed here
 /// (polygon_edge_ns).

@@ -205,13 +205,17 @@ Calibration calibrate(std::span<const CalibrationSample> samples, const TimeTerm
                              std::to_string(fitted) + " unit costs, have " + std::to_string(samples.size()) +
                              " (measure more scenes or hierarchies, or fit fewer terms)");
     std::vector<double> x = nnls(a, b, usable);
-    // A primitive kind that the runs test but the fit prices at 0 is not priced: NNLS clamped an
-    // unknown the runs cannot tell from another (the second half of docs/time-model.md tests
-    // spheres only beside cones, in lattice and tree; fitted there, spheres came out free and
-    // shells, all spheres, was ranked with rho 0.15). Then the fit is made again with each
-    // primitive price pulled toward the mean of the kinds tested, weakly (a deviation of the
-    // whole mean weighs as a tenth of a run's relative error): along what the runs fix they
-    // decide, and only where they fix nothing does the pull choose.
+    // The primitive prices are then fitted again, each pulled toward the mean of the kinds the
+    // runs test, as hard as the runs' own scatter: the pull's rows weigh the fit's rms relative
+    // residual, so that a price moving by the whole mean costs as much as a run of typical error.
+    // Runs a time model explains exactly are not pulled at all; noisy runs that fix a price poorly
+    // (spheres tested only beside cones, in lattice and tree: the sum is fixed, not each) leave
+    // it near the other kinds' instead of wherever the noise put it. Fitted on docs/time-model.md's
+    // second half without the pull, spheres came out at 4.5 ns, and shells (all spheres) was
+    // ranked with rho 0.81; a loop timing each kind is no prior (a triangle alone in a loop took
+    // 36 ns, with the per-ray shear and cache misses a traversal does not pay per test).
+    // A kind priced at 0 by NNLS (one the runs cannot tell from another) is pulled at least with
+    // weight 0.1 however well the runs fit.
     std::vector<int> kinds;
     bool clamped = false;
     double mean = 0;
@@ -222,12 +226,20 @@ Calibration calibrate(std::span<const CalibrationSample> samples, const TimeTerm
             mean += x[4 + k];
         }
     mean /= std::max<std::size_t>(kinds.size(), 1);
-    if (clamped && kinds.size() >= 2 && mean > 0) {
+    double scatter = 0;
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        double r = -b[i];
+        for (int j = 0; j < kUnknowns; ++j) r += a[i][j] * x[j];
+        scatter += r * r;
+    }
+    scatter = a.empty() ? 0.0 : std::sqrt(scatter / a.size());
+    constexpr double kClampedPull = 0.1;
+    const double pull = std::max(scatter, clamped ? kClampedPull : 0.0);
+    if (pull > 1e-9 && kinds.size() >= 2 && mean > 0) {
         for (int k : kinds) {
             std::vector<double> row(kUnknowns, 0.0);
-            constexpr double kPull = 0.1;
-            for (int j : kinds) row[j] = -kPull / (kinds.size() * mean);
-            row[k] += kPull / mean;
+            for (int j : kinds) row[j] = -pull / (kinds.size() * mean);
+            row[k] += pull / mean;
             a.push_back(std::move(row));
             b.push_back(0.0);
         }

@@ -1,0 +1,188 @@
+// Fitting nanoseconds per operation kind to measured times (rtcost calibrate): synthetic runs
+// timed by known costs, exact or with a deterministic scatter, must give the costs back, or where
+// the runs cannot fix a price, a price near the others'.
+#include <cmath>
+
+#include "rtcost/error.hpp"
+#include "rtcost/model.hpp"
+#include "test_support.hpp"
+
+namespace rtcost::test {
+namespace {
+
+TEST(Calibrate, RecoversKnownUnitCostsAndKeepsThemNonNegative) {
+    // Synthetic runs timed by known costs: the fit must give them back.
+    UnitCosts truth;
+    truth.box = 3; truth.plane = 0; truth.hop = 7; truth.classify = 2; truth.per_ray = 40;
+    truth.prim = {20, 55, 9, 0};
+    std::vector<CalibrationSample> runs;
+    for (int i = 0; i < 12; ++i) {
+        CalibrationSample s;
+        s.label = "run " + std::to_string(i);
+        s.ops.box = 5 + 3 * i;
+        s.ops.hop = (i % 3) * 4.0;
+        s.ops.classify = (i % 4 == 1) ? 30.0 : 0.0;
+        s.ops.prim = {1.0 + i % 5, (i % 2) * 2.0, 3.0 + (i * 7) % 4, 0};
+        s.ns_per_ray = truth.scalar(s.ops);
+        runs.push_back(s);
+    }
+    Calibration c = calibrate(runs);
+    EXPECT_NEAR(c.costs.box, 3, 1e-6);
+    EXPECT_NEAR(c.costs.hop, 7, 1e-6);
+    EXPECT_NEAR(c.costs.classify, 2, 1e-6);
+    EXPECT_NEAR(c.costs.prim[0], 20, 1e-6);
+    EXPECT_NEAR(c.costs.prim[1], 55, 1e-6);
+    EXPECT_NEAR(c.costs.prim[2], 9, 1e-6);
+    EXPECT_NEAR(c.costs.per_ray, 40, 1e-5);
+    EXPECT_FALSE(c.fitted[1]);  // no run performs a plane compare
+    EXPECT_NEAR(c.rms_relative, 0, 1e-9);
+    // Times that only a negative box cost would fit: the fit stays at zero instead.
+    for (auto& s : runs) s.ns_per_ray = 100 - s.ops.box + 20 * s.ops.prim[0] + 9 * s.ops.prim[2];
+    Calibration n = calibrate(runs);
+    EXPECT_GE(n.costs.box, 0);
+    EXPECT_GT(n.rms_relative, 0);
+    // Fewer runs than unknowns: an error, not a guess.
+    EXPECT_THROW(calibrate(std::span(runs).first(3)), InputError);
+}
+
+TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
+    // Runs timed by a known time model: per step, SIMD box tests priced apart, and a cache term
+    // for structures beyond 1 MiB. The fit must give every term back.
+    UnitCosts truth;
+    truth.box = 3; truth.plane = 5; truth.hop = 0; truth.classify = 0; truth.per_ray = 20;
+    truth.prim = {12, 30, 0, 0};
+    truth.step = 6; truth.box_simd = 0.5; truth.cache = 2; truth.cache_bytes = 1 << 20;
+    std::vector<CalibrationSample> runs;
+    for (int i = 0; i < 16; ++i) {
+        CalibrationSample s;
+        s.label = "run " + std::to_string(i);
+        s.ops.box = 4 + 5 * (i % 7);
+        s.ops.plane = (i % 3) * 6.0;
+        s.ops.steps = 3 + (i * 5) % 11;
+        s.ops.prim = {1.0 + i % 4, (i % 2) * 3.0, 0, 0};
+        s.structure.box_lanes = i % 4 == 3 ? 8 : 1;
+        s.structure.bytes = std::uint64_t(1) << (16 + i % 9);  // 64 KiB .. 16 MiB
+        s.ns_per_ray = truth.scalar(s.ops, s.structure);
+        runs.push_back(s);
+    }
+    Calibration c = calibrate(runs, {}, 1 << 20);
+    EXPECT_NEAR(c.costs.box, 3, 1e-6);
+    EXPECT_NEAR(c.costs.plane, 5, 1e-6);
+    EXPECT_NEAR(c.costs.step, 6, 1e-6);
+    EXPECT_NEAR(c.costs.box_simd, 0.5, 1e-6);
+    EXPECT_NEAR(c.costs.cache, 2, 1e-6);
+    EXPECT_NEAR(c.costs.per_ray, 20, 1e-5);
+    EXPECT_NEAR(c.rms_relative, 0, 1e-9);
+    // The same runs fitted by operations alone cannot explain them.
+    Calibration ops = calibrate(runs, {false, false, false, false}, 1 << 20);
+    EXPECT_GT(ops.rms_relative, 0.01);
+    EXPECT_EQ(ops.costs.step, 0);
+    EXPECT_LT(ops.costs.box_simd, 0);  // not fitted: priced as box
+    EXPECT_FALSE(ops.fitted[ops.fitted.size() - 4]);  // step
+    EXPECT_FALSE(ops.fitted.back());                  // polygon_edge
+    // No SIMD structure among the runs: box_simd stays unfitted.
+    for (auto& s : runs) s.structure.box_lanes = 1;
+    for (auto& s : runs) s.ns_per_ray = truth.scalar(s.ops, s.structure);
+    EXPECT_LT(calibrate(runs, {}, 1 << 20).costs.box_simd, 0);
+}
+
+TEST(Calibrate, AKindTheRunsCannotTellFromAnotherIsNotPricedAtZero) {
+    // Spheres only ever tested beside as many cones (as in tree.nff): the runs fix their sum, not
+    // each. NNLS alone may price one of them at 0; the fit then pulls the kinds toward their mean.
+    UnitCosts truth;
+    truth.box = 4; truth.plane = 0; truth.hop = 0; truth.classify = 0; truth.per_ray = 10;
+    truth.prim = {10, 0, 6, 20};
+    std::vector<CalibrationSample> runs;
+    for (int i = 0; i < 12; ++i) {
+        CalibrationSample s;
+        s.label = "run " + std::to_string(i);
+        s.ops.box = 6 + 5 * (i % 4);
+        const double paired = (i * 3) % 5;
+        s.ops.prim = {1.0 + i % 3, 0, paired, paired};
+        s.ns_per_ray = truth.scalar(s.ops);
+        runs.push_back(s);
+    }
+    TimeTerms ops_only;
+    ops_only.steps = ops_only.simd = ops_only.cache = ops_only.edges = false;
+    const Calibration c = calibrate(runs, ops_only);
+    const double sphere = c.costs.prim[2], cone = c.costs.prim[3];
+    EXPECT_GT(sphere, 1);
+    EXPECT_GT(cone, 1);
+    EXPECT_NEAR(sphere + cone, 26, 0.05);  // what the runs do fix
+    EXPECT_NEAR(c.costs.prim[0], 10, 0.3);  // a kind the runs fix moves by a few percent at most
+    EXPECT_LT(c.rms_relative, 0.01);
+}
+
+TEST(Calibrate, PricesPolygonEdgesAtTheirTimedCostAndFitsTheRest) {
+    // Runs with polygons of many vertices (gears' 144-gons): their time is their tests' price plus
+    // an edge price the fit is handed (timed on the machine by default). The rest comes back
+    // exactly; a fit without the edges' term cannot explain the runs.
+    UnitCosts truth;
+    truth.box = 4; truth.plane = 0; truth.hop = 0; truth.classify = 0; truth.per_ray = 10;
+    truth.prim = {15, 11, 0, 0};
+    truth.polygon_edge = 1.5;
+    std::vector<CalibrationSample> runs;
+    for (int i = 0; i < 12; ++i) {
+        CalibrationSample s;
+        s.label = "run " + std::to_string(i);
+        s.ops.box = 10 + 3 * (i % 5);
+        s.ops.prim = {1.0 + i % 3, 2.0 + (i * 3) % 4, 0, 0};
+        // Some runs walk quads' edges only, others 144-gons' too.
+        s.ops.polygon_edges = 4 * s.ops.prim[1] + (i % 2) * 144.0 * (1 + i % 3);
+        s.ns_per_ray = truth.scalar(s.ops);
+        runs.push_back(s);
+    }
+    TimeTerms edges{false, false, false, true};
+    Calibration c = calibrate(runs, edges, 1 << 20, 1.5);
+    EXPECT_DOUBLE_EQ(c.costs.polygon_edge, 1.5);
+    EXPECT_TRUE(c.fitted.back());
+    EXPECT_NEAR(c.costs.box, 4, 1e-6);
+    EXPECT_NEAR(c.costs.prim[0], 15, 1e-6);
+    EXPECT_NEAR(c.costs.prim[1], 11, 1e-6);
+    EXPECT_NEAR(c.costs.per_ray, 10, 1e-5);
+    EXPECT_NEAR(c.rms_relative, 0, 1e-9);
+    // Priced back: a run's fitted time holds its edges.
+    EXPECT_NEAR(c.predicted[1], runs[1].ns_per_ray, 1e-6 * runs[1].ns_per_ray);
+    Calibration without = calibrate(runs, {false, false, false, false}, 1 << 20);
+    EXPECT_EQ(without.costs.polygon_edge, 0);
+    EXPECT_GT(without.rms_relative, 0.05);
+}
+
+TEST(Calibrate, APriceNoisyRunsFixPoorlyStaysNearTheOtherKinds) {
+    // Spheres tested nearly only beside as many cones (lattice and tree), with the scatter of real
+    // timings: the runs fix the sum of the two prices and little else. Unpulled, where the sum
+    // falls between them moves with the noise (for these patterns, spheres anywhere from 0 to 21
+    // ns). Pulled toward the kinds' mean by the runs' own scatter, each stays near the mean
+    // whatever the noise, and the sum stays what the runs fix.
+    UnitCosts truth;
+    truth.box = 4; truth.plane = 0; truth.hop = 0; truth.classify = 0; truth.per_ray = 10;
+    truth.prim = {10, 0, 8, 20};
+    TimeTerms ops_only;
+    ops_only.steps = ops_only.simd = ops_only.cache = ops_only.edges = false;
+    for (int pattern = 0; pattern < 8; ++pattern) {
+        std::vector<CalibrationSample> runs;
+        for (int i = 0; i < 16; ++i) {
+            CalibrationSample s;
+            s.label = "run " + std::to_string(i);
+            s.ops.box = 6 + 5 * (i % 4);
+            const double paired = 1 + (i * 3) % 5;
+            s.ops.prim = {1.0 + i % 3, 0, paired, paired + 0.25 * (i % 2)};
+            // A deterministic scatter of +-15%, its phase set by the pattern.
+            s.ns_per_ray = truth.scalar(s.ops) * (1 + 0.15 * std::sin(12.9898 * i + 0.8 * pattern));
+            runs.push_back(s);
+        }
+        const Calibration c = calibrate(runs, ops_only);
+        const double sphere = c.costs.prim[2], cone = c.costs.prim[3];
+        SCOPED_TRACE("pattern " + std::to_string(pattern) + ": sphere " + std::to_string(sphere) + ", cone " +
+                     std::to_string(cone));
+        EXPECT_NEAR(sphere + cone, 28, 2.8);
+        EXPECT_GT(sphere, 10);
+        EXPECT_LT(sphere, 17);
+        EXPECT_GT(cone, 10);
+        EXPECT_LT(cone, 17);
+        EXPECT_GT(c.rms_relative, 0.05);  // the scatter is there: the fit does not hide it
+    }
+}
+
+}  // namespace
+}  // namespace rtcost::test
