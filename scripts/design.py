@@ -190,7 +190,8 @@ def main():
              + (f"the ns per operation of `{a.costs}`" if a.costs else
                 "each family's default costs: typical ns per operation (rtcost's built-in `UnitCosts::typical`, "
                 "the time model fitted on the twelve scenes of docs/time-model.md, with its step, cache and "
-                "polygon-edge terms) for bvh and kd, operation counts for grid, octree and bsp") + ".", "",
+                "polygon-edge terms) for bvh and kd, operation counts for grid, octree and bsp (`ops`: a polygon "
+                "edge walked counts as the share of a test the time model gives it, about a quarter)") + ".", "",
              "| scene | rays | family | sample | test rays | build s (design / yardstick) | predicted ops | measured ops | ns per ray | Embree ns | gain |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for scene, dist, doc, r in rows:

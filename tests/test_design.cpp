@@ -122,10 +122,23 @@ TEST(Design, DesignsMinimiseTypicalTimeUnlessToldOtherwise) {
     EXPECT_FALSE(counts.costs.calibrated);
     EXPECT_EQ(counts.costs.box, 1.0);
     EXPECT_EQ(counts.costs.prim[0], 1.0);
+    EXPECT_EQ(counts.costs.polygon_edge, 0.0);  // the paper's counts: a polygon test is one operation
+    // ops: the same counts, with each edge a polygon's test walks at the share of that test the
+    // typical costs give it (gears' 144-gons then cost some 30 operations a test, a quad's 2).
+    std::vector<std::string> ops = base;
+    ops.push_back("costs=ops");
+    const DesignInput with_edges = draw_design_input(s, Params(design_param_specs(), ops));
+    EXPECT_FALSE(with_edges.costs.calibrated);
+    EXPECT_EQ(with_edges.costs.box, 1.0);
+    EXPECT_EQ(with_edges.costs.prim[static_cast<int>(PrimKind::Polygon)], 1.0);
+    const UnitCosts t = UnitCosts::typical();
+    EXPECT_DOUBLE_EQ(with_edges.costs.polygon_edge, t.polygon_edge / t.prim[static_cast<int>(PrimKind::Polygon)]);
+    EXPECT_GT(with_edges.costs.polygon_edge, 0.1);
+    EXPECT_LT(with_edges.costs.polygon_edge, 0.5);
     // Each family's default: time where the fitted costs describe its traversal, else counts.
     for (const auto& [name, want] : std::vector<std::pair<std::string, std::string>>{
-             {"bvh-design", "typical"}, {"kd-design", "typical"}, {"grid-design", "unit"},
-             {"octree-design", "unit"}, {"bsp-design", "unit"}}) {
+             {"bvh-design", "typical"}, {"kd-design", "typical"}, {"grid-design", "ops"},
+             {"octree-design", "ops"}, {"bsp-design", "ops"}}) {
         std::string got;
         for (const ParamSpec& p : find_hierarchy(name)->params)
             if (p.name == "costs") got = p.default_value;

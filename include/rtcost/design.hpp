@@ -22,9 +22,10 @@ namespace rtcost {
 /// The parameters of every designed hierarchy, with their defaults (rays=spd, sample=4096,
 /// seed=1, size=128x128: the image of camera-based rays the sample is drawn from) and the
 /// family's default `costs`: "typical" where typical ns per operation describe the family's
-/// traversal time (BVHs, kd-trees: docs/design.md measured gains with them), "unit" where they
-/// do not (the subdivisions' locate traversals and grids, whose time the fit leaves 30-75% off
-/// and whose designs lost against unit costs).
+/// traversal time (BVHs, kd-trees: docs/design.md measured gains with them), "ops" (operation
+/// counts, polygon edges at a share of a test) where they do not (the subdivisions' locate
+/// traversals and grids, whose time the fit leaves 30-75% off and whose designs lost against
+/// operation counts).
 std::vector<ParamSpec> design_param_specs(const std::string& default_costs = "typical");
 
 /// A designed hierarchy's sample and the costs it minimises.
@@ -72,7 +73,7 @@ struct DesignOptions {
     std::size_t sample = 4096;
     std::uint64_t seed = 1;               ///< the sample's draw
     /// What the designs minimise and the table reports: a calibrated costs file (ns), "unit"
-    /// (operations), "typical", or empty: each family's default (design_param_specs), operations
+    /// or "ops" (operations), "typical", or empty: each family's default (design_param_specs), operations
     /// reported.
     std::string costs_file;
     std::function<void(const std::string&)> on_step;

@@ -72,7 +72,9 @@ struct UnitCosts {
     /// tests that cost several times more (docs/design.md). Fitted by `rtcost calibrate` on one
     /// machine (unit_costs.cpp says which); their ratios, not their nanoseconds, steer a design.
     static UnitCosts typical();
-    /// "unit" (operation counts), "typical" (typical()) or a costs file's path.
+    /// "unit" (the paper's operation counts), "ops" (operation counts with each polygon edge a
+    /// crossing test walks at the share of the test typical() gives it), "typical" (typical()) or a
+    /// costs file's path.
     static UnitCosts named(const std::string& name);
 };
 

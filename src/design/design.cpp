@@ -55,7 +55,8 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
     res.scene = scene.name;
     // The table reports operations unless a costs file is given; the designs minimise the
     // named costs (typical ns per operation by default).
-    res.calibrated = !opt.costs_file.empty() && opt.costs_file != "unit" && opt.costs_file != "typical";
+    res.calibrated = !opt.costs_file.empty() && opt.costs_file != "unit" && opt.costs_file != "ops" &&
+                     opt.costs_file != "typical";
     res.designed_for = opt.costs_file.empty() ? "each family's default" : opt.costs_file;
     UnitCosts costs;
     if (res.calibrated) costs = UnitCosts::read(opt.costs_file);
@@ -138,9 +139,10 @@ nlohmann::json to_json(const DesignResult& r) {
 
 std::string design_table(const DesignResult& r) {
     const std::string aim = r.designed_for == "each family's default"
-                                ? "each family's default: typical ns per operation (bvh, kd), operations (grid, octree, bsp)"
+                                ? "each family's default: typical ns per operation (bvh, kd), operations with polygon edges (grid, octree, bsp)"
                             : r.designed_for == "typical" ? "typical ns per operation (built in)"
                             : r.designed_for == "unit"  ? "operations (unit costs)"
+                            : r.designed_for == "ops"   ? "operations, polygon edges at a share of a test"
                                                         : "ns per operation of " + r.designed_for;
     std::string s = fmt::format("scene      {}\nrays       {}: design sample {}, test rays {} (disjoint)\ncosts      {}\n"
                                 "designed   to minimise {}\n\n",

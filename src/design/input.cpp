@@ -16,8 +16,9 @@ std::vector<ParamSpec> design_param_specs(const std::string& default_costs) {
             ParamSpec::integer("sample", "4096", 1, 1 << 20, "rays in the design sample (at most half the distribution)"),
             ParamSpec::integer("seed", "1", 0, 1LL << 62, "seed of the sample's draw (the distribution's own seed is 1)"),
             ParamSpec::text("costs", default_costs,
-                            "ns per operation the design minimises: typical (built in), unit (operation counts), or a "
-                            "costs file of rtcost calibrate")};
+                            "ns per operation the design minimises: typical (built in), unit (the paper's operation "
+                            "counts), ops (operation counts, a polygon's edges at the share of its test the built-in "
+                            "time model gives them), or a costs file of rtcost calibrate")};
 }
 
 DesignInput draw_design_input(const Scene& scene, const Params& p) {

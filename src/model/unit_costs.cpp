@@ -56,6 +56,17 @@ UnitCosts UnitCosts::typical() {
 
 UnitCosts UnitCosts::named(const std::string& name) {
     if (name == "unit") return UnitCosts{};
+    if (name == "ops") {
+        // Operation counts, with each edge a polygon's crossing test walks counted at the share
+        // of that test the built-in time model gives it (about a quarter). The paper's unit
+        // costs count a test of gears' 144-gons as one operation, like a quad's: a grid designed
+        // with them walked 60 more edges per ray than the fastest of a sweep to save 2 hops, and
+        // was 17% slower than it (docs/design.md, 2026-12-04).
+        UnitCosts c;
+        const UnitCosts t = typical();
+        c.polygon_edge = t.polygon_edge / t.prim[static_cast<int>(PrimKind::Polygon)];
+        return c;
+    }
     if (name == "typical" || name.empty()) return typical();
     return read(name);
 }

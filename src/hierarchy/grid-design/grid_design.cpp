@@ -83,7 +83,7 @@ std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, 
 namespace {
 
 std::vector<ParamSpec> params() {
-    std::vector<ParamSpec> p = design_param_specs("unit");
+    std::vector<ParamSpec> p = design_param_specs("ops");
     // 32, not 8: on balls and tree the model's optimum lies beyond 8 cells per primitive, where a
     // sweep of grids measured the fastest (16 and more), and the search stopped at the cap.
     p.push_back(ParamSpec::real("max_density", "32", 0.01, 64, "largest candidate grid, in cells per primitive"));

@@ -14,7 +14,7 @@ namespace rtcost {
 namespace {
 
 std::vector<ParamSpec> specs(int default_depth, int max_depth, int default_prims) {
-    std::vector<ParamSpec> p = design_param_specs("unit");
+    std::vector<ParamSpec> p = design_param_specs("ops");
     for (const ParamSpec& q : subdiv::param_specs(default_depth, max_depth, default_prims)) p.push_back(q);
     p.push_back(ParamSpec::real("trust", "32", 0, 1e30, "sample segments at a cell at which sample and surface area weigh alike"));
     return p;
