@@ -38,13 +38,19 @@ def run(binary, scene, dist, families, size, sample, costs=None):
     return json.loads(out), time.time() - start
 
 
+# Timed passes per variant in a sweep, interleaved, the median kept: with the default (as many as
+# take 0.2 s, two on the larger scenes) one disturbed pass moved a grid 40% off its own copy.
+SWEEP_PASSES = 7
+
+
 def sweep(binary, scene, dist, size, sample, designed, variants):
     """One `rtcost eval --interleave` run (one core, segments estimator: the same test rays as
     `rtcost design`) of the designed hierarchy and every variant of its yardstick, timed in rounds
     so that a change of the machine's load weighs on all alike; ns per ray by label."""
     hs = ",".join([designed] + variants)
     cmd = ["taskset", "-c", "0", binary, "eval", scene, "-H", hs, "--rays", dist, "--size", size,
-           "--estimator", "segments", "--sample", str(sample), "-j", "1", "--interleave", "--json", "--quiet"]
+           "--estimator", "segments", "--sample", str(sample), "-j", "1", "--interleave", "--repeat", str(SWEEP_PASSES),
+           "--json", "--quiet"]
     doc = json.loads(subprocess.run(cmd, check=True, capture_output=True, text=True).stdout)
     return [(r["hierarchy"], r["time"]["measured_ns_per_ray"], r["measured"]["cost"]) for r in doc["results"]]
 
@@ -69,7 +75,7 @@ def sweep_tables(raw, dist, counts=None):
         n = (counts or {}).get(fam, len(runs[0][2]) if runs else 0)
         what = "hetero grids at densities 2^(k/3), k = -9..12" if fam == "grid" else "kd-sah c_trav 5..30 x empty_bonus 0, 0.2, 0.5"
         out += ["", f"## {fam}-design against a sweep of its yardstick's parameters (`{dist}` rays)", "",
-                f"Every variant in one `rtcost eval -j 1 --interleave` run with the designed one, pinned to one core (all built, then timed in rounds of one pass each): {n} variants ({what}).", "",
+                f"Every variant in one `rtcost eval -j 1 --interleave` run with the designed one, pinned to one core (all built, then timed in {SWEEP_PASSES} rounds of one pass each, the median kept): {n} variants ({what}).", "",
                 "| scene | designed ns | best of sweep | best ns | designed / best | designed ops | best's ops | best ops of sweep |",
                 "|---|---|---|---|---|---|---|---|"]
         for scene, d, variants in runs:
