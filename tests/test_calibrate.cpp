@@ -10,22 +10,30 @@
 namespace rtcost::test {
 namespace {
 
+/// `n` synthetic runs, `fill(i, run)` setting run i's operations (and structure), each timed
+/// exactly by `truth`'s time model.
+template <class Fill>
+std::vector<CalibrationSample> timed_runs(const UnitCosts& truth, int n, Fill&& fill) {
+    std::vector<CalibrationSample> runs(n);
+    for (int i = 0; i < n; ++i) {
+        runs[i].label = "run " + std::to_string(i);
+        fill(i, runs[i]);
+        runs[i].ns_per_ray = truth.scalar(runs[i].ops, runs[i].structure);
+    }
+    return runs;
+}
+
 TEST(Calibrate, RecoversKnownUnitCostsAndKeepsThemNonNegative) {
     // Synthetic runs timed by known costs: the fit must give them back.
     UnitCosts truth;
     truth.box = 3; truth.plane = 0; truth.hop = 7; truth.classify = 2; truth.per_ray = 40;
     truth.prim = {20, 55, 9, 0};
-    std::vector<CalibrationSample> runs;
-    for (int i = 0; i < 12; ++i) {
-        CalibrationSample s;
-        s.label = "run " + std::to_string(i);
+    std::vector<CalibrationSample> runs = timed_runs(truth, 12, [&](int i, CalibrationSample& s) {
         s.ops.box = 5 + 3 * i;
         s.ops.hop = (i % 3) * 4.0;
         s.ops.classify = (i % 4 == 1) ? 30.0 : 0.0;
         s.ops.prim = {1.0 + i % 5, (i % 2) * 2.0, 3.0 + (i * 7) % 4, 0};
-        s.ns_per_ray = truth.scalar(s.ops);
-        runs.push_back(s);
-    }
+    });
     Calibration c = calibrate(runs);
     EXPECT_NEAR(c.costs.box, 3, 1e-6);
     EXPECT_NEAR(c.costs.hop, 7, 1e-6);
@@ -52,19 +60,14 @@ TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
     truth.box = 3; truth.plane = 5; truth.hop = 0; truth.classify = 0; truth.per_ray = 20;
     truth.prim = {12, 30, 0, 0};
     truth.step = 6; truth.box_simd = 0.5; truth.cache = 2; truth.cache_bytes = 1 << 20;
-    std::vector<CalibrationSample> runs;
-    for (int i = 0; i < 16; ++i) {
-        CalibrationSample s;
-        s.label = "run " + std::to_string(i);
+    std::vector<CalibrationSample> runs = timed_runs(truth, 16, [&](int i, CalibrationSample& s) {
         s.ops.box = 4 + 5 * (i % 7);
         s.ops.plane = (i % 3) * 6.0;
         s.ops.steps = 3 + (i * 5) % 11;
         s.ops.prim = {1.0 + i % 4, (i % 2) * 3.0, 0, 0};
         s.structure.box_lanes = i % 4 == 3 ? 8 : 1;
         s.structure.bytes = std::uint64_t(1) << (16 + i % 9);  // 64 KiB .. 16 MiB
-        s.ns_per_ray = truth.scalar(s.ops, s.structure);
-        runs.push_back(s);
-    }
+    });
     Calibration c = calibrate(runs, {}, 1 << 20);
     EXPECT_NEAR(c.costs.box, 3, 1e-6);
     EXPECT_NEAR(c.costs.plane, 5, 1e-6);
@@ -92,16 +95,11 @@ TEST(Calibrate, AKindTheRunsCannotTellFromAnotherIsNotPricedAtZero) {
     UnitCosts truth;
     truth.box = 4; truth.plane = 0; truth.hop = 0; truth.classify = 0; truth.per_ray = 10;
     truth.prim = {10, 0, 6, 20};
-    std::vector<CalibrationSample> runs;
-    for (int i = 0; i < 12; ++i) {
-        CalibrationSample s;
-        s.label = "run " + std::to_string(i);
+    std::vector<CalibrationSample> runs = timed_runs(truth, 12, [&](int i, CalibrationSample& s) {
         s.ops.box = 6 + 5 * (i % 4);
         const double paired = (i * 3) % 5;
         s.ops.prim = {1.0 + i % 3, 0, paired, paired};
-        s.ns_per_ray = truth.scalar(s.ops);
-        runs.push_back(s);
-    }
+    });
     TimeTerms ops_only;
     ops_only.steps = ops_only.simd = ops_only.cache = ops_only.edges = false;
     const Calibration c = calibrate(runs, ops_only);
@@ -121,17 +119,12 @@ TEST(Calibrate, PricesPolygonEdgesAtTheirTimedCostAndFitsTheRest) {
     truth.box = 4; truth.plane = 0; truth.hop = 0; truth.classify = 0; truth.per_ray = 10;
     truth.prim = {15, 11, 0, 0};
     truth.polygon_edge = 1.5;
-    std::vector<CalibrationSample> runs;
-    for (int i = 0; i < 12; ++i) {
-        CalibrationSample s;
-        s.label = "run " + std::to_string(i);
+    std::vector<CalibrationSample> runs = timed_runs(truth, 12, [&](int i, CalibrationSample& s) {
         s.ops.box = 10 + 3 * (i % 5);
         s.ops.prim = {1.0 + i % 3, 2.0 + (i * 3) % 4, 0, 0};
         // Some runs walk quads' edges only, others 144-gons' too.
         s.ops.polygon_edges = 4 * s.ops.prim[1] + (i % 2) * 144.0 * (1 + i % 3);
-        s.ns_per_ray = truth.scalar(s.ops);
-        runs.push_back(s);
-    }
+    });
     TimeTerms edges{false, false, false, true};
     Calibration c = calibrate(runs, edges, 1 << 20, 1.5);
     EXPECT_DOUBLE_EQ(c.costs.polygon_edge, 1.5);
@@ -160,17 +153,13 @@ TEST(Calibrate, APriceNoisyRunsFixPoorlyStaysNearTheOtherKinds) {
     TimeTerms ops_only;
     ops_only.steps = ops_only.simd = ops_only.cache = ops_only.edges = false;
     for (int pattern = 0; pattern < 8; ++pattern) {
-        std::vector<CalibrationSample> runs;
-        for (int i = 0; i < 16; ++i) {
-            CalibrationSample s;
-            s.label = "run " + std::to_string(i);
+        std::vector<CalibrationSample> runs = timed_runs(truth, 16, [&](int i, CalibrationSample& s) {
             s.ops.box = 6 + 5 * (i % 4);
             const double paired = 1 + (i * 3) % 5;
             s.ops.prim = {1.0 + i % 3, 0, paired, paired + 0.25 * (i % 2)};
-            // A deterministic scatter of +-15%, its phase set by the pattern.
-            s.ns_per_ray = truth.scalar(s.ops) * (1 + 0.15 * std::sin(12.9898 * i + 0.8 * pattern));
-            runs.push_back(s);
-        }
+        });
+        // A deterministic scatter of +-15%, its phase set by the pattern.
+        for (int i = 0; i < 16; ++i) runs[i].ns_per_ray *= (1 + 0.15 * std::sin(12.9898 * i + 0.8 * pattern));
         const Calibration c = calibrate(runs, ops_only);
         const double sphere = c.costs.prim[2], cone = c.costs.prim[3];
         SCOPED_TRACE("pattern " + std::to_string(pattern) + ": sphere " + std::to_string(sphere) + ", cone " +

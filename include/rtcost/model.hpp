@@ -76,6 +76,8 @@ struct UnitCosts {
     /// crossing test walks at the share of the test typical() gives it), "typical" (typical()) or a
     /// costs file's path.
     static UnitCosts named(const std::string& name);
+    /// Whether named() takes `name` as one of its built-in tables rather than a costs file.
+    static bool built_in(const std::string& name) { return name == "unit" || name == "ops" || name == "typical"; }
 };
 
 /// One calibration run: the measured operations per ray and the measured single-thread

@@ -55,8 +55,7 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
     res.scene = scene.name;
     // The table reports operations unless a costs file is given; the designs minimise the
     // named costs (typical ns per operation by default).
-    res.calibrated = !opt.costs_file.empty() && opt.costs_file != "unit" && opt.costs_file != "ops" &&
-                     opt.costs_file != "typical";
+    res.calibrated = !opt.costs_file.empty() && !UnitCosts::built_in(opt.costs_file);
     res.designed_for = opt.costs_file.empty() ? "each family's default" : opt.costs_file;
     UnitCosts costs;
     if (res.calibrated) costs = UnitCosts::read(opt.costs_file);
