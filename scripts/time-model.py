@@ -123,7 +123,22 @@ def main():
                 "the pull was made only when a kind came out at 0 ns; the second fold then priced spheres at "
                 "4.5-4.7 ns (its runs' scatter decided where the sum fell), shells (all spheres) was ranked "
                 "with rho 0.893, and over the twelve scenes the time model erred by 35.2% on average, with "
-                "8 of 12 scenes at rho 0.95 or more.\n\n")
+                "8 of 12 scenes at rho 0.95 or more.\n\n"
+                "Timing: `calibrate` builds every hierarchy of a scene, then times them in five interleaved "
+                "rounds (one pass each per round, the fastest pass kept), so that a slow spell of the machine "
+                "falls on all of a scene's hierarchies alike rather than on one, whose rank it would change. "
+                "Until 2026-12-04 each hierarchy was timed three times right after its build; two runs of this "
+                "script then gave 9 and 10 of 12 scenes at rho 0.95 or more (time model), two runs with the "
+                "rounds (this one and one before it) 11 of 12 each.\n\n"
+                "Tried and not kept (2026-12-04): a scene term, ns per primitive test for each doubling of the "
+                "scene's primitive data beyond the cache, charged to structures whose leaves read the scene's "
+                "primitives where they lie (all but the BVHs, which test copies of their triangles in leaf "
+                "order). 2CylinderEngine's grids are timed 60% above their prediction, the BVHs within 5%. The "
+                "two folds disagreed: fitted with 2CylinderEngine the term came out at 7.3 ns, and yxa_1 (as "
+                "large, its grid testing 125 triangles per ray at 16 ns each, a cell's triangles adjacent in "
+                "the file) was then predicted 36% off instead of 28%; fitted with yxa_1 it came out at 0.4 ns, "
+                "and 2CylinderEngine's rho moved from 0.900 to 0.918. Where the scene's primitives lie in "
+                "memory matters, not only how large it is.\n\n")
         f.write("## Summary\n\n| model | mean absolute error | rho, worst scene | rho, median | scenes at rho >= 0.95 |\n"
                 "|---|---|---|---|---|\n")
         for label, _ in MODELS:

@@ -279,6 +279,28 @@ TEST(CliModel, CalibrateTermsChooseTheTimeModel) {
     EXPECT_EQ(u.box_simd, ja["box_simd"].get<double>());
 }
 
+TEST(CliModel, CalibrateTimesInRoundsOrOneAtATimeOverTheSameRuns) {
+    // By default a scene's hierarchies are all built, then timed in interleaved rounds;
+    // --sequential times and frees each after its build. The runs (and the lazily built rc5d's
+    // growth) are the same either way, in the order asked.
+    fs::path costs = temp_dir() / "rounds.json";
+    const std::string runs = "calibrate builtin:balls:2 builtin:tetra:3 -H bvh-sah,grid,rc5d,kd-sah --size 24x24 "
+                             "--repeat 2 --terms ops -q --json -o " + costs.string();
+    CliRun rounds = run_cli(runs), one = run_cli(runs + " --sequential");
+    ASSERT_EQ(rounds.code, 0) << rounds.err;
+    ASSERT_EQ(one.code, 0) << one.err;
+    auto a = nlohmann::json::parse(rounds.out)["runs"], b = nlohmann::json::parse(one.out)["runs"];
+    ASSERT_EQ(a.size(), 8u);
+    ASSERT_EQ(b.size(), 8u);
+    const char* order[] = {"bvh-sah", "grid", "rc5d", "kd-sah"};
+    for (std::size_t i = 0; i < a.size(); ++i) {
+        EXPECT_EQ(a[i]["run"], b[i]["run"]);
+        EXPECT_EQ(a[i]["run"].get<std::string>().rfind(order[i % 4], 0), 0u) << a[i]["run"];
+        EXPECT_GT(a[i]["measured_ns_per_ray"].get<double>(), 0.0) << a[i]["run"];
+        EXPECT_GT(b[i]["measured_ns_per_ray"].get<double>(), 0.0) << b[i]["run"];
+    }
+}
+
 TEST(CliModel, EvalInterleavedTimesEveryRowAndCountsTheSame) {
     const std::string run = "eval builtin:balls:2 -H bvh-sah,grid,brute --size 24x24 --repeat 3 -q --json";
     CliRun plain = run_cli(run), inter = run_cli(run + " --interleave");
