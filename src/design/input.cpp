@@ -18,7 +18,7 @@ std::vector<ParamSpec> design_param_specs(const std::string& default_costs) {
             ParamSpec::text("costs", default_costs,
                             "ns per operation the design minimises: typical (built in), unit (the paper's operation "
                             "counts), ops (operation counts, a polygon's edges at the share of its test the built-in "
-                            "time model gives them), or a costs file of rtcost calibrate")};
+                            "time model gives them), or a costs file of rtcost calibrate (./ops for a file called ops)")};
 }
 
 DesignInput draw_design_input(const Scene& scene, const Params& p) {
