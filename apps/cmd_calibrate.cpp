@@ -53,7 +53,10 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     const TimeTerms terms = parse_terms(a.terms);
     std::vector<CalibrationSample> samples, held;
     std::vector<std::string> held_scene;
-    const std::size_t total = (a.scenes.size() + a.held_out.size()) * names.size();
+    // Progress in passes: per scene and hierarchy, the counted one and the timed ones.
+    const std::size_t per_run = 1 + static_cast<std::size_t>(a.repeat);
+    const std::size_t total = (a.scenes.size() + a.held_out.size()) * names.size() * per_run;
+    std::size_t passes = 0;
     Progress progress("calibrate", total, common.quiet || common.json);
     auto measure = [&](const std::string& spec, std::vector<CalibrationSample>& into, std::vector<std::string>* scene_of) {
         Scene scene = load(spec, common, a.rays.view);
@@ -67,29 +70,34 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
             double best = kInf;
         };
         std::vector<Timed> timed;
-        // CPU time, the fastest of several runs: the least disturbed by the machine (and, for
-        // lazily built structures, the runs after the build). Interleaved (every hierarchy once
-        // per round, all built first), a slow spell of the machine falls on every hierarchy of
-        // the scene alike instead of on one, whose rank among the others it would change; the
-        // rank is what the held-out check judges.
-        auto time_once = [&](Timed& t) { t.best = std::min(t.best, trace_ray_set(*t.h, rays, opt).cpu_seconds); };
+        // CPU time, the fastest of several passes: the least disturbed by the machine. Counted
+        // first, so that a lazily built structure (rc5d) is complete when timed. Interleaved
+        // (every hierarchy once per round, all built first), a slow spell of the machine falls
+        // on every hierarchy of the scene alike instead of on one, whose rank among the others
+        // it would change; the rank is what the held-out check judges.
+        auto time_once = [&](Timed& t) {
+            t.best = std::min(t.best, trace_ray_set(*t.h, rays, opt).cpu_seconds);
+            progress.update(++passes);
+        };
         for (const HierarchyRequest& req : names) {
             auto h = build_hierarchy(scene, req.name, req.params);
-            if (!h->counted()) continue;  // Embree's operations are not counted
+            if (!h->counted()) {  // Embree's operations are not counted
+                progress.update(passes += per_run);
+                continue;
+            }
             Timed t{std::move(h), {}, kInf};
-            if (a.sequential)
-                for (int r = 0; r < a.repeat; ++r) time_once(t);
             TraceOptions counting = opt;
             counting.count = true;
             const TraceResult counted = trace_ray_set(*t.h, rays, counting);
+            progress.update(++passes);
             t.s.label = req.label() + " on " + scene.name;
             t.s.ops = measured_cost(counted.counters);
             if (a.sequential) {
+                for (int r = 0; r < a.repeat; ++r) time_once(t);
                 t.s.structure = t.h->structure();
                 t.h.reset();
             }
             timed.push_back(std::move(t));
-            progress.update(samples.size() + held.size() + timed.size());
         }
         if (!a.sequential)
             for (int r = 0; r < a.repeat; ++r)
@@ -100,7 +108,6 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
             into.push_back(std::move(t.s));
             if (scene_of) scene_of->push_back(scene.name);
         }
-        progress.update(samples.size() + held.size());
     };
     for (const std::string& spec : a.scenes) measure(spec, samples, nullptr);
     for (const std::string& spec : a.held_out) measure(spec, held, &held_scene);
@@ -147,12 +154,14 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         json runs = json::array();
         for (std::size_t i = 0; i < samples.size(); ++i)
             runs.push_back({{"run", samples[i].label}, {"measured_ns_per_ray", samples[i].ns_per_ray},
-                            {"fitted_ns_per_ray", c.predicted[i]},
+                            {"fitted_ns_per_ray", c.predicted[i]}, {"operations", UnitCosts{}.scalar(samples[i].ops)},
+                            {"structure_bytes", samples[i].structure.bytes},
                             {"residual", (c.predicted[i] - samples[i].ns_per_ray) / samples[i].ns_per_ray}});
         json held_runs = json::array(), rho = json::object();
         for (std::size_t i = 0; i < held.size(); ++i)
             held_runs.push_back({{"run", held[i].label}, {"measured_ns_per_ray", held[i].ns_per_ray},
-                                 {"predicted_ns_per_ray", held_pred[i]},
+                                 {"predicted_ns_per_ray", held_pred[i]}, {"operations", UnitCosts{}.scalar(held[i].ops)},
+                                 {"structure_bytes", held[i].structure.bytes},
                                  {"error", (held_pred[i] - held[i].ns_per_ray) / held[i].ns_per_ray}});
         for (const auto& [scene, v] : by_scene) rho[scene] = rank_correlation(v.first, v.second);
         json out = {{"costs_file", a.out}, {"ns_per_operation", fit}, {"rms_relative_residual", c.rms_relative},
@@ -211,8 +220,8 @@ Subcommand setup_calibrate(CLI::App& parent, Common& common) {
         ->capture_default_str();
     add_ray_args(cmd, a->rays);
     cmd->add_option("--repeat", a->repeat,
-                    "timed runs per hierarchy and scene (the fastest counts), in rounds over every hierarchy of the "
-                    "scene once all are built")
+                    "timed passes per hierarchy and scene (the fastest counts), in rounds over every hierarchy of "
+                    "the scene once all are built (unless --sequential)")
         ->check(CLI::Range(1, 100))
         ->capture_default_str();
     cmd->add_flag("--sequential", a->sequential,

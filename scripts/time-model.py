@@ -34,6 +34,7 @@ HALVES = (["balls", "gears", "mount", "rings", "shells", "2CylinderEngine"],
 HIERARCHIES = ("bsp,bsp-design,bvh-design,bvh-gs,bvh-median,bvh-sah,bvh-wide,grid,grid-design,"
                "kd-design,kd-median,kd-sah,octree,octree-design,rc5d")
 MODELS = [("operations", "ops"), ("time model", "ops,steps,simd,cache,edges")]
+REPEAT = 5  # timed passes per hierarchy, in interleaved rounds (calibrate --repeat)
 
 
 def path_of(scene):
@@ -49,7 +50,8 @@ def calibrate(fit, held, terms, core, args, out):
     cmd = ["taskset", "-c", str(core), CLI, "calibrate"] + [path_of(s) for s in fit]
     for s in held:
         cmd += ["--held-out", path_of(s)]
-    cmd += ["-H", HIERARCHIES, "--rays", args.rays, "--size", args.size, "--terms", terms, "-o", out, "-q", "--json"]
+    cmd += ["-H", HIERARCHIES, "--rays", args.rays, "--size", args.size, "--terms", terms, "--repeat", str(REPEAT),
+            "-o", out, "-q", "--json"]
     res = subprocess.run(cmd, check=True, capture_output=True, text=True)
     return json.loads(res.stdout)
 
@@ -124,12 +126,12 @@ def main():
                 "4.5-4.7 ns (its runs' scatter decided where the sum fell), shells (all spheres) was ranked "
                 "with rho 0.893, and over the twelve scenes the time model erred by 35.2% on average, with "
                 "8 of 12 scenes at rho 0.95 or more.\n\n"
-                "Timing: `calibrate` builds every hierarchy of a scene, then times them in five interleaved "
+                f"Timing: `calibrate` counts every hierarchy of a scene, then times them in {REPEAT} interleaved "
                 "rounds (one pass each per round, the fastest pass kept), so that a slow spell of the machine "
                 "falls on all of a scene's hierarchies alike rather than on one, whose rank it would change. "
                 "Until 2026-12-04 each hierarchy was timed three times right after its build; two runs of this "
-                "script then gave 9 and 10 of 12 scenes at rho 0.95 or more (time model), two runs with the "
-                "rounds (this one and one before it) 11 of 12 each.\n\n"
+                "script on 2026-12-04 then gave 9 and 10 of 12 scenes at rho 0.95 or more (time model), and "
+                "three runs with the rounds that day 11 of 12 each.\n\n"
                 "Tried and not kept (2026-12-04): a scene term, ns per primitive test for each doubling of the "
                 "scene's primitive data beyond the cache, charged to structures whose leaves read the scene's "
                 "primitives where they lie (all but the BVHs, which test copies of their triangles in leaf "

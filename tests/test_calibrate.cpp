@@ -2,9 +2,6 @@
 // timed by known costs, exact or with a deterministic scatter, must give the costs back, or where
 // the runs cannot fix a price, a price near the others'.
 #include <cmath>
-#include <filesystem>
-#include <fstream>
-#include <unistd.h>
 
 #include "rtcost/error.hpp"
 #include "rtcost/model.hpp"
@@ -174,38 +171,6 @@ TEST(Calibrate, APriceNoisyRunsFixPoorlyStaysNearTheOtherKinds) {
         EXPECT_LT(cone, 17);
         EXPECT_GT(c.rms_relative, 0.05);  // the scatter is there: the fit does not hide it
     }
-}
-
-}  // namespace
-}  // namespace rtcost::test
-
-namespace rtcost::test {
-namespace {
-
-TEST(CostTables, ABuiltInNameThatIsAlsoAFileHereIsAnErrorAndDotSlashNamesTheFile) {
-    // `costs=ops` would otherwise take the built-in table and silently ignore a costs file
-    // called ops in the working directory.
-    namespace fs = std::filesystem;
-    const fs::path dir = fs::temp_directory_path() / ("rtcost_test_costs_" + std::to_string(::getpid()));
-    fs::create_directories(dir);
-    {
-        std::ofstream out(dir / "ops");
-        out << R"({"unit": "ns", "box": 7.5, "prim": {"triangle": 12}})";
-    }
-    const fs::path before = fs::current_path();
-    fs::current_path(dir);
-    EXPECT_THROW(UnitCosts::named("ops"), InputError);
-    try {
-        UnitCosts::named("ops");
-    } catch (const InputError& e) {
-        EXPECT_NE(std::string(e.what()).find("./ops"), std::string::npos) << e.what();
-    }
-    const UnitCosts file = UnitCosts::named("./ops");
-    EXPECT_EQ(file.box, 7.5);
-    EXPECT_EQ(file.prim[static_cast<int>(PrimKind::Triangle)], 12);
-    EXPECT_EQ(UnitCosts::named("unit").box, 1.0);  // no file called unit here: the built-in
-    fs::current_path(before);
-    fs::remove_all(dir);
 }
 
 }  // namespace

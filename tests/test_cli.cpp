@@ -281,8 +281,9 @@ TEST(CliModel, CalibrateTermsChooseTheTimeModel) {
 
 TEST(CliModel, CalibrateTimesInRoundsOrOneAtATimeOverTheSameRuns) {
     // By default a scene's hierarchies are all built, then timed in interleaved rounds;
-    // --sequential times and frees each after its build. The runs (and the lazily built rc5d's
-    // growth) are the same either way, in the order asked.
+    // --sequential times and frees each after its build. Each is counted before it is timed, so
+    // the runs are the same either way, in the order asked: the same operations, and the same
+    // structure (the lazily built rc5d's included).
     fs::path costs = temp_dir() / "rounds.json";
     const std::string runs = "calibrate builtin:balls:2 builtin:tetra:3 -H bvh-sah,grid,rc5d,kd-sah --size 24x24 "
                              "--repeat 2 --terms ops -q --json -o " + costs.string();
@@ -296,6 +297,10 @@ TEST(CliModel, CalibrateTimesInRoundsOrOneAtATimeOverTheSameRuns) {
     for (std::size_t i = 0; i < a.size(); ++i) {
         EXPECT_EQ(a[i]["run"], b[i]["run"]);
         EXPECT_EQ(a[i]["run"].get<std::string>().rfind(order[i % 4], 0), 0u) << a[i]["run"];
+        EXPECT_EQ(a[i]["operations"], b[i]["operations"]) << a[i]["run"];
+        EXPECT_GT(a[i]["operations"].get<double>(), 1.0) << a[i]["run"];
+        EXPECT_EQ(a[i]["structure_bytes"], b[i]["structure_bytes"]) << a[i]["run"];
+        EXPECT_GT(a[i]["structure_bytes"].get<double>(), 0.0) << a[i]["run"];
         EXPECT_GT(a[i]["measured_ns_per_ray"].get<double>(), 0.0) << a[i]["run"];
         EXPECT_GT(b[i]["measured_ns_per_ray"].get<double>(), 0.0) << b[i]["run"];
     }

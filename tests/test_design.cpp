@@ -1,8 +1,11 @@
 // The designed hierarchies: exact hits like every hierarchy (closest and any-hit), the same
 // structure for the same seed, the SAH's tree where the sample is given no weight, a grid
 // resolution no worse on the sample than the formula's, and `rtcost design`'s rows.
+#include <filesystem>
+#include <fstream>
 #include <random>
 #include <type_traits>
+#include <unistd.h>
 
 #include "../src/design/sample_reach.hpp"
 #include "../src/hierarchy/bvh-design/boxes_met.hpp"
@@ -147,6 +150,49 @@ TEST(Design, DesignsMinimiseTypicalTimeUnlessToldOtherwise) {
     std::vector<std::string> missing = base;
     missing.push_back("costs=/nonexistent/costs.json");
     EXPECT_THROW(draw_design_input(s, Params(design_param_specs(), missing)), InputError);
+}
+
+TEST(Design, ACostsFileCalledLikeABuiltInTableIsRefusedWhenAskedForByThatName) {
+    // costs=ops would take the built-in table and silently ignore a costs file called ops in the
+    // working directory; ./ops names the file. A family's default (ops or typical) is the table
+    // whatever the directory holds, and a directory of that name is no costs file.
+    namespace fs = std::filesystem;
+    struct InTempDir {  // the working directory is restored and the files removed, whatever fails
+        fs::path dir, before;
+        InTempDir() : dir(fs::temp_directory_path() / ("rtcost_test_costs_" + std::to_string(::getpid()))) {
+            fs::create_directories(dir / "typical");  // a directory called like a table
+            std::ofstream(dir / "ops") << R"({"unit": "ns", "box": 7.5, "prim": {"triangle": 12}})";
+            before = fs::current_path();
+            fs::current_path(dir);
+        }
+        ~InTempDir() {
+            std::error_code ec;
+            fs::current_path(before, ec);
+            fs::remove_all(dir, ec);
+        }
+    } here;
+    const Scene s = builtin_scene("balls", 2);
+    auto input = [&](const std::string& costs) {
+        std::vector<std::string> set = {"rays=camera", "size=16x16", "sample=32"};
+        if (!costs.empty()) set.push_back("costs=" + costs);
+        return draw_design_input(s, Params(design_param_specs(), set));
+    };
+    try {
+        input("ops");
+        ADD_FAILURE() << "costs=ops with a file called ops here was taken";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("./ops"), std::string::npos) << e.what();
+    }
+    const DesignInput file = input("./ops");
+    EXPECT_EQ(file.costs.box, 7.5);
+    EXPECT_EQ(file.costs.prim[static_cast<int>(PrimKind::Triangle)], 12);
+    EXPECT_EQ(input("unit").costs.box, 1.0);  // no file called unit: the table
+    // The default (typical) beside a directory called typical: the table.
+    EXPECT_EQ(input("").costs.box, UnitCosts::typical().box);
+    EXPECT_EQ(input("typical").costs.box, UnitCosts::typical().box);
+    // grid-design's default is ops: the table, beside the file called ops.
+    auto built = build_hierarchy(s, "grid-design", {"rays=camera", "size=16x16", "sample=32"});
+    EXPECT_GT(built->structure().leaves, 0u);
 }
 
 TEST(Design, BvhDesignWithNoSampleWeightIsTheSahTree) {

@@ -74,8 +74,7 @@ struct UnitCosts {
     static UnitCosts typical();
     /// "unit" (the paper's operation counts), "ops" (operation counts with each polygon edge a
     /// crossing test walks at the share of the test typical() gives it), "typical" (typical()) or a
-    /// costs file's path. Throws InputError for a built-in name that is also a file in the
-    /// working directory (`./ops` names the file).
+    /// costs file's path (`./ops` names a file called ops).
     static UnitCosts named(const std::string& name);
     /// Whether named() takes `name` as one of its built-in tables rather than a costs file.
     static bool built_in(const std::string& name) { return name == "unit" || name == "ops" || name == "typical"; }

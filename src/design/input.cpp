@@ -1,6 +1,7 @@
 // The designed hierarchies' shared parameters, their sample, and the sample's predicted cost.
 #include <algorithm>
 #include <array>
+#include <filesystem>
 
 #include "rtcost/design.hpp"
 #include "rtcost/error.hpp"
@@ -18,7 +19,7 @@ std::vector<ParamSpec> design_param_specs(const std::string& default_costs) {
             ParamSpec::text("costs", default_costs,
                             "ns per operation the design minimises: typical (built in), unit (the paper's operation "
                             "counts), ops (operation counts, a polygon's edges at the share of its test the built-in "
-                            "time model gives them), or a costs file of rtcost calibrate (./ops for a file called ops)")};
+                            "time model gives them), or a costs file of rtcost calibrate (./ops: a file called ops)")};
 }
 
 DesignInput draw_design_input(const Scene& scene, const Params& p) {
@@ -28,7 +29,15 @@ DesignInput draw_design_input(const Scene& scene, const Params& p) {
     in.spec.seed = 1;
     in.count = static_cast<std::size_t>(p.integer("sample"));
     in.seed = static_cast<std::uint64_t>(p.integer("seed"));
-    in.costs = UnitCosts::named(p.str("costs"));
+    // A costs file called like a built-in table, named without a directory, would be taken for
+    // the table: refused when asked for (a family's own default is the table, file or not).
+    const std::string& costs = p.str("costs");
+    std::error_code ec;
+    if (costs != p.spec("costs").default_value && UnitCosts::built_in(costs) && std::filesystem::is_regular_file(costs, ec))
+        throw InputError("--set costs", 0,
+                         "'" + costs + "' names both a built-in cost table and a file in this directory: ./" + costs +
+                             " for the file");
+    in.costs = UnitCosts::named(costs);
     // One bvh-sah both makes the sample's rays (if the distribution is made by tracing: only
     // at the sample's pixels) and finds the sample's ends.
     auto reference = build_hierarchy(scene, "bvh-sah");

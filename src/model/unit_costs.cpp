@@ -55,11 +55,6 @@ UnitCosts UnitCosts::typical() {
 }
 
 UnitCosts UnitCosts::named(const std::string& name) {
-    // A costs file called like a built-in table would be silently ignored: say so instead.
-    std::error_code ec;
-    if (built_in(name) && std::filesystem::exists(name, ec))
-        throw InputError(name, 0, "names both a built-in cost table and a file in this directory: write ./" + name +
-                                      " for the file");
     if (name == "unit") return UnitCosts{};
     if (name == "ops") {
         // Operation counts, with each edge a polygon's crossing test walks counted at the share
