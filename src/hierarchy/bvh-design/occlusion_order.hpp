@@ -43,6 +43,9 @@ private:
         const RayInv ri(ray);
         counting.box();
         if (box_entry(nodes[0].box, ri, ray.tmin, ray.tmax) == kInf) return false;
+        // The leaves' tests of bvh-sah's walk: triangle copies in leaf order, one shear per ray.
+        const RayShear shear = bvh_.shear_of(ray);
+        bool found = false;
         struct Entry {
             std::uint32_t node;
             int depth;
@@ -54,8 +57,7 @@ private:
             const Node& n = nodes[e.node];
             if (n.leaf) {
                 counting.leaf(e.depth, n.count);
-                for (std::uint32_t k = 0; k < n.count; ++k)
-                    if (test_prim(*scene_, d.refs[n.index + k], ray, hit, counting)) return true;
+                if (bvh_.template test_leaf_of<C, Query::Any>(n, ray, shear, hit, counting, found)) return true;
             } else {
                 counting.interior(e.depth);
                 Entry next[kMaxFanout];
@@ -69,6 +71,7 @@ private:
                 if (nn > 0) {
                     // The first is entered next, the others wait, last to first.
                     for (int i = nn - 1; i > 0; --i) stack[sp++] = next[i];
+                    if (nn > 1) bvh_.prefetch_node(next[1].node);
                     e = next[0];
                     continue;
                 }

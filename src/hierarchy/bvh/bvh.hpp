@@ -74,6 +74,19 @@ public:
     void set_any_leaves_first(bool on) { any_leaves_first_ = on; }
     bool any_leaves_first() const { return any_leaves_first_; }
 
+    /// For another walk of the same nodes (bvh-design's occlusion order): leaf `n`'s primitive
+    /// tests as this BVH's own walk makes them, on its triangle copies in leaf order with the
+    /// ray's shear `shear` (shear_of), counted alike; true when an any-hit query ends.
+    template <class C, Query Q>
+    bool test_leaf_of(const Node& n, const Ray& ray, const RayShear& shear, Hit& hit, C& counting, bool& found) const {
+        RealPrimTest test{*scene_};
+        return test_leaf<C, Q>(n.index, n.count, ray, shear, hit, counting, found, test);
+    }
+    /// The shear a walk hands test_leaf_of: made only for a tree with triangles to test.
+    RayShear shear_of(const Ray& ray) const { return has_triangles_ ? RayShear(ray.d) : RayShear(); }
+    /// Fetches what a visit of node `i` reads first (a walk about to wait on memory).
+    void prefetch_node(std::uint32_t i) const { prefetch(d_.nodes[i]); }
+
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
         return trace_with<C, Q>(ray, hit, counting, RealPrimTest{*scene_});
