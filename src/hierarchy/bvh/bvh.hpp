@@ -118,7 +118,7 @@ private:
         const Node* nodes = d_.nodes.data();
         const RayInv ri(ray);
         // Three divisions a ray pays only where there are triangles to test (not in a scene of spheres).
-        const RayShear shear = has_triangles_ ? RayShear(ray.d) : RayShear();
+        const RayShear shear = shear_of(ray);
         counting.box();
         float t0 = box_entry(nodes[0].box, ri, ray.tmin, ray.tmax);
         if (t0 == kInf) return false;
