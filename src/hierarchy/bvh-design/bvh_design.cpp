@@ -3,12 +3,11 @@
 // ends, that meet the child's box), blended with the surface-area ratio where few segments reach
 // the node; a node stays a leaf where no split pays; and the order in which occlusion rays enter
 // a node's children: front to back or leaf children first, whichever the model predicts cheaper
-// on the sample (or, with occlusion=sample, an order bit per node: occlusion_order.hpp).
+// on the sample (or, with occlusion=sample, an order bit per node from the sample, on the designed
+// tree or on bvh-sah's, whichever its own walk prices cheaper on the sample: occlusion_order.hpp).
 // Otherwise traversed as every BVH (../bvh/bvh.hpp).
 #include <algorithm>
 #include <unordered_map>
-
-#include <map>
 
 #include "../bvh/topdown.hpp"
 #include "boxes_met.hpp"
@@ -108,28 +107,7 @@ void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t begin, std
     for (std::size_t i = 0; i < keep; ++i) cuts.push_back(sc.all[sc.order[i]]);
 }
 
-struct Designed {
-    BvhData data;
-    std::vector<std::uint8_t> right_first;
-};
-
-// Each interior node's order bit from the (begin, end) primitive ranges the builder decided it on.
-std::vector<std::uint8_t> order_bits(const BvhData& d, const std::map<std::pair<std::uint32_t, std::uint32_t>, bool>& by_range) {
-    std::vector<std::uint8_t> bits(d.nodes.size(), 0);
-    auto range = [&](auto&& self, std::uint32_t i) -> std::pair<std::uint32_t, std::uint32_t> {
-        const Node& n = d.nodes[i];
-        if (n.leaf) return {n.index, n.index + n.count};
-        const auto l = self(self, n.index);
-        const auto r = self(self, n.index + n.count - 1);
-        for (std::uint32_t k = 1; k + 1 < n.count; ++k) self(self, n.index + k);
-        if (auto it = by_range.find({l.first, r.second}); it != by_range.end()) bits[i] = it->second;
-        return {l.first, r.second};
-    };
-    if (!d.nodes.empty()) range(range, 0);
-    return bits;
-}
-
-Designed build_design(const Scene& s, const DesignInput& in, const DesignOptions& o) {
+BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions& o) {
     PrimInfo info(s);
     const RaySample& smp = in.sample;
     std::vector<RayInv> inv;
@@ -150,11 +128,6 @@ Designed build_design(const Scene& s, const DesignInput& in, const DesignOptions
     // The sample segments reaching each node, keyed by the node's first primitive: a node is split
     // before its subtrees are built, and the left child's subtree is done before the right one's.
     std::unordered_map<std::uint32_t, std::vector<std::uint32_t>> reaching;
-    // Occlusion order: the child an any-hit ray reaching the node is likelier to end in (one of
-    // its known crossings lies among the child's primitives and its segment meets the child's
-    // box), per primitive to test there, is entered first.
-    std::map<std::pair<std::uint32_t, std::uint32_t>, bool> right_first;
-    std::vector<std::uint8_t> side(s.size(), 0);
     {
         std::vector<std::uint32_t> all;
         for (std::uint32_t r = 0; r < smp.size(); ++r)
@@ -243,28 +216,11 @@ Designed build_design(const Scene& s, const DesignInput& in, const DesignOptions
             mid = static_cast<std::uint32_t>(it - ids.begin());
             if (w == 0) best_left = best_right = {};
         }
-        if (!rays.empty() && mid > begin && mid < end) {
-            for (std::uint32_t i = begin; i < end; ++i) side[ids[i]] = i < mid ? 1 : 2;
-            Box3 lb, rb;
-            for (std::uint32_t i = begin; i < mid; ++i) lb.extend(info.bounds[ids[i]]);
-            for (std::uint32_t i = mid; i < end; ++i) rb.extend(info.bounds[ids[i]]);
-            double ends[3] = {0, 0, 0};
-            for (std::uint32_t r : rays) {
-                if (smp.queries[r] != Query::Any) continue;
-                bool in_side[3] = {false, false, false};
-                for (const Crossing& c : smp.crossings_of(r)) in_side[side[c.prim]] = true;
-                if (in_side[1] && meets(r, lb)) ++ends[1];
-                if (in_side[2] && meets(r, rb)) ++ends[2];
-            }
-            for (std::uint32_t i = begin; i < end; ++i) side[ids[i]] = 0;
-            if (ends[1] * (end - mid) < ends[2] * (mid - begin)) right_first[{begin, end}] = true;
-        }
         reaching[begin] = std::move(best_left);
         reaching[mid] = std::move(best_right);
         return mid;
     });
-    std::vector<std::uint8_t> bits = order_bits(data, right_first);
-    return {std::move(data), std::move(bits)};
+    return data;
 }
 
 const Registration reg{
@@ -282,7 +238,8 @@ const Registration reg{
              "order in which occlusion rays enter a node's children: near (front to back, as every BVH), leaves "
              "(leaf children first, then front to back), auto (of near and leaves, the one the model predicts "
              "cheaper on the sample), or sample (the child likelier to end the ray per primitive first, an order "
-             "bit per node; outside the model's exact replay)"));
+             "bit per node, on the designed tree or bvh-sah's, whichever its walk prices cheaper on the sample; outside "
+             "the model's exact replay)"));
          p.push_back(ParamSpec::real("trust", "32", 0, 1e30,
                                      "sample segments at a node at which sample and surface area weigh alike "
                                      "(large: the surface area heuristic)"));
@@ -296,19 +253,19 @@ const Registration reg{
          o.candidates = static_cast<int>(p.integer("candidates"));
          o.trust = p.real("trust");
          const DesignInput in = draw_design_input(s, p);
-         Designed d = build_design(s, in, o);
+         BvhData designed_tree = build_design(s, in, o);
          // bvh-sah's tree where the model predicts it cheaper on the sample than the designed
          // splits (as design/cheaper.hpp does for the other families).
          SahOptions usual;
          usual.max_depth = o.max_depth;
          usual.bins = o.bins;
-         auto designed = std::make_unique<Bvh>(s, "bvh-design", d.data, true);
          // With bvh-sah's defaults that tree is the sample's reference, already built.
          const SahOptions sah_defaults;
          const auto* reference = dynamic_cast<const Bvh*>(in.reference.get());
          const bool as_reference = reference && usual.max_depth == sah_defaults.max_depth && usual.bins == sah_defaults.bins;
          auto by_sah = std::make_unique<Bvh>(s, "bvh-design", as_reference ? reference->data() : build_sah(s, usual), true);
          if (!p.is("occlusion", "sample")) {
+             auto designed = std::make_unique<Bvh>(s, "bvh-design", std::move(designed_tree), true);
              // Each tree in the order asked for, or in the order the model predicts cheaper on
              // the sample (only its occlusion rays can tell the two apart).
              const bool any_query = std::find(in.sample.queries.begin(), in.sample.queries.end(), Query::Any) !=
@@ -335,10 +292,19 @@ const Registration reg{
              if (best.h == designed.get()) return designed;
              return by_sah;
          }
-         if (sample_cost(*by_sah, s, in.sample, in.costs) <
-             sample_cost(*designed, s, in.sample, in.costs))
-             return by_sah;
-         return std::make_unique<DesignedBvh>(s, std::move(d.data), std::move(d.right_first));
+         // Of bvh-sah's tree walked front to back and each tree with its order bits, the cheapest
+         // by its own traversal of the sample (the model's replay goes front to back and would
+         // not see an order's gain); a tie keeps the designed splits.
+         const designing::SampleReplay replay(s, in.sample, in.costs);
+         std::vector<std::uint8_t> sah_bits = occlusion_bits(by_sah->data(), s, in.sample);
+         auto sah_ordered = std::make_unique<DesignedBvh>(s, by_sah->data(), std::move(sah_bits));
+         std::vector<std::uint8_t> designed_bits = occlusion_bits(designed_tree, s, in.sample);
+         auto designed_ordered = std::make_unique<DesignedBvh>(s, std::move(designed_tree), std::move(designed_bits));
+         const double c_designed = replay.time(*designed_ordered), c_sah_ordered = replay.time(*sah_ordered),
+                      c_sah = replay.time(*by_sah);
+         if (c_sah < c_designed && c_sah <= c_sah_ordered) return by_sah;
+         if (c_sah_ordered < c_designed) return sah_ordered;
+         return designed_ordered;
      }}};
 
 }  // namespace

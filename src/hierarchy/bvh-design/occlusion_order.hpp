@@ -7,8 +7,14 @@
 #include <vector>
 
 #include "../bvh/bvh.hpp"
+#include "rtcost/sample.hpp"
 
 namespace rtcost::bvh {
+
+/// The order bits of any binary BVH `d` over `s` (DesignedBvh's right_first) from `sample`'s
+/// occlusion rays: at each binary node, the child entered first is the one more of the rays that
+/// reach it (their segments clipped where their search ends) end in, per primitive below it.
+std::vector<std::uint8_t> occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sample);
 
 class DesignedBvh final : public HierarchyImpl<DesignedBvh> {
 public:
@@ -22,8 +28,15 @@ public:
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        if constexpr (Q == Query::Any) return occlusion(ray, hit, counting);
+        if constexpr (Q == Query::Any) return occlusion(ray, hit, counting, RealPrimTest{scene()});
         else return bvh_.template trace<C, Q>(ray, hit, counting);
+    }
+
+    /// The traversal with the caller's primitive test (design/replay.hpp prices it on a sample).
+    template <class C, Query Q, class PrimTest>
+    bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {
+        if constexpr (Q == Query::Any) return occlusion(ray, hit, counting, test);
+        else return bvh_.template trace_with<C, Q>(ray, hit, counting, test);
     }
 
 protected:
@@ -36,8 +49,8 @@ protected:
 private:
     // Counted as the BVH's walk counts: one box for the root, per interior visit interior(depth)
     // and one box per child, per leaf visit leaf(depth, n) and its primitive tests.
-    template <class C>
-    bool occlusion(const Ray& ray, Hit& hit, C& counting) const {
+    template <class C, class PrimTest>
+    bool occlusion(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {
         const BvhData& d = bvh_.data();
         const Node* nodes = d.nodes.data();
         const RayInv ri(ray);
@@ -57,7 +70,7 @@ private:
             const Node& n = nodes[e.node];
             if (n.leaf) {
                 counting.leaf(e.depth, n.count);
-                if (bvh_.template test_leaf_of<C, Query::Any>(n, ray, shear, hit, counting, found)) return true;
+                if (bvh_.template test_leaf_of<C, Query::Any>(n, ray, shear, hit, counting, found, test)) return true;
             } else {
                 counting.interior(e.depth);
                 Entry next[kMaxFanout];
