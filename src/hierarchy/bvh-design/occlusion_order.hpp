@@ -1,8 +1,9 @@
 #pragma once
 // bvh-design's hierarchy: the BVH's nodes and traversal for closest-hit and all-hits queries,
 // and for occlusion (any-hit) queries a walk that enters first, at each node, the child the
-// design sample says is likelier to end the ray per unit of its cost (one order bit per node):
-// an any-hit query needs no hit nearer than another, only one soon.
+// design sample says is likelier to end the ray per unit of its cost (an order byte per node,
+// by the sign of the ray's direction on the node's axis): an any-hit query needs no hit nearer
+// than another, only one soon.
 
 #include <vector>
 
@@ -11,14 +12,18 @@
 
 namespace rtcost::bvh {
 
-/// The order bits of any binary BVH `d` over `s` (DesignedBvh's right_first) from `sample`'s
-/// occlusion rays: at each binary node, the child entered first is the one more of the rays that
-/// reach it (their segments clipped where their search ends) end in, per primitive below it.
+/// The order bytes of any binary BVH `d` over `s` (DesignedBvh's right_first) from `sample`'s
+/// occlusion rays: at each binary node, for the rays going each way along the node's axis (the one
+/// its children's centres lie furthest apart on), the child entered first is the one more of those
+/// that reach it (their segments clipped where their search ends) end in, per primitive below it;
+/// by all the node's rays where none going that way ends below it.
+/// Byte: the axis (bits 0-1), second child first for a positive direction (bit 2), for a
+/// negative one (bit 3).
 std::vector<std::uint8_t> occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sample);
 
 class DesignedBvh final : public HierarchyImpl<DesignedBvh> {
 public:
-    /// `right_first[i]`: interior node i's second child is entered first by occlusion rays.
+    /// `right_first[i]`: interior node i's order byte (occlusion_bits).
     DesignedBvh(const Scene& s, BvhData data, std::vector<std::uint8_t> right_first)
         : HierarchyImpl(s), bvh_(s, "bvh-design", std::move(data), true), right_first_(std::move(right_first)) {}
 
@@ -80,7 +85,10 @@ private:
                     if (box_entry(nodes[n.index + k].box, ri, ray.tmin, ray.tmax) != kInf)
                         next[nn++] = {n.index + k, e.depth + 1};
                 }
-                if (nn == 2 && right_first_[e.node]) std::swap(next[0], next[1]);
+                if (nn == 2) {
+                    const std::uint8_t b = right_first_[e.node];
+                    if ((b >> (2 + ri.neg[b & 3])) & 1) std::swap(next[0], next[1]);
+                }
                 if (nn > 0) {
                     // The first is entered next, the others wait, last to first.
                     for (int i = nn - 1; i > 0; --i) stack[sp++] = next[i];
