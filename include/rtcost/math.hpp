@@ -120,6 +120,13 @@ struct RayInv {
     return t0 <= t1 ? t0 : kInf;
 }
 
+/// Where a traversal that culls by the nearest hit so far (`t`) stops entering boxes: a little
+/// beyond it. A box's entry distance rounds up to a few ulps past the distance a primitive inside
+/// it gets from its own test (a ray through a shared vertex met a triangle at 0.99999988 whose
+/// box it entered at 1, behind another triangle's hit at 1), so boxes entered within a relative
+/// 2^-16 of the hit are still searched: an extra visit, never a lost hit.
+inline float cull_bound(float t) { return t * 1.0000153f; }
+
 /// box_entry with the entry and exit faces chosen by the direction's signs (no compare and swap
 /// per axis): the same result, for traversals that test many boxes per ray.
 // Always inlined: called per child box in every traversal's inner loop, where a translation

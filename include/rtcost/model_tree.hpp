@@ -96,6 +96,9 @@ struct ModelFlags {
     /// A closest-hit query skips what lies beyond the nearest hit found so far (false: the
     /// traversal visits everything the segment meets, e.g. a BVH with `order=none`).
     bool cull = true;
+    /// Culling compares with cull_bound(hit) (math.hpp), a relative 2^-16 beyond the hit, rather
+    /// than with the hit itself (the BVHs' traversals).
+    bool cull_widened = false;
     /// A ray that misses the root's region ends at the root test (false: every ray enters the
     /// root whatever it meets, as brute force's does).
     bool gated = true;

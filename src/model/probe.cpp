@@ -150,7 +150,9 @@ private:
     // Nothing more is searched: an any-hit query has its hit.
     bool done() const { return any_ && found_; }
     // A closest-hit traversal skips a segment that starts at or beyond the nearest hit so far.
-    bool beyond(const Segment& s) const { return cull_ && s.t0 >= hit_.t; }
+    bool beyond(const Segment& s) const { return cull_ && s.t0 >= bound(); }
+    // What the traversal culls by: the nearest hit, or a little beyond it (ModelFlags::cull_widened).
+    float bound() const { return t_.cull_widened ? cull_bound(hit_.t) : hit_.t; }
     // A child's segment, cut at the nearest hit so far when the traversal culls by it; empty
     // where the traversal does not enter it (model::meets), and where it starts at or beyond
     // that hit: no traversal enters a region there (a BVH pops it, a subdivision has stopped at
@@ -158,7 +160,7 @@ private:
     // is not entered either.
     Segment child(std::uint32_t c, const Segment& s) const {
         Segment x = clip_segment(ri_, t_.nodes[c].region, s);
-        if (cull_ && hit_.t < x.t1) x.t1 = hit_.t;
+        if (cull_ && bound() < x.t1) x.t1 = bound();
         if (!meets(t_, s, x) || beyond(x)) x = Segment{kInf, -kInf};
         return x;
     }

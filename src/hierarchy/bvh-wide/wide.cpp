@@ -263,6 +263,7 @@ StructureStats BvhWide::compute_structure() const {
 
 bool BvhWide::emit_model(ModelSink& sink) const {
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
+    f.cull_widened = true;
     f.any_leaves_first = d_->any_order == kAnyLeaves;
     if (!sink.begin(f) || d_->root_count == 0) return true;
     ModelNode root;

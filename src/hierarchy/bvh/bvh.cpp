@@ -27,6 +27,7 @@ StructureStats Bvh::compute_structure() const {
 bool Bvh::emit_model(ModelSink& sink) const {
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     f.cull = ordered_;
+    f.cull_widened = ordered_;
     f.any_leaves_first = ordered_ && any_leaves_first_;
     if (!sink.begin(f) || d_.nodes.empty()) return true;
     // Every builder lays leaves' references out depth first: a subtree's run of refs starts at

@@ -136,7 +136,7 @@ private:
             // near child) or popped from the stack at `pop`.
             {
                 if constexpr (kOrdered) {
-                    if (e.t >= hit.t) goto pop;  // the whole box lies beyond the current hit
+                    if (e.t >= cull_bound(hit.t)) goto pop;  // the whole box lies beyond the current hit
                 }
                 const Node& n = nodes[e.node];
                 if (n.leaf) {
@@ -145,7 +145,7 @@ private:
                     goto pop;
                 }
                 counting.interior(e.depth);
-                const float limit = kOrdered ? std::min(hit.t, ray.tmax) : ray.tmax;
+                const float limit = kOrdered ? std::min(cull_bound(hit.t), ray.tmax) : ray.tmax;
                 if (n.count == 2) {
                     // Binary nodes (all but Goldsmith-Salmon's): no sort, and the near child is
                     // visited next without a trip through the stack.
