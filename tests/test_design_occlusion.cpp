@@ -1,4 +1,4 @@
-// bvh-design's occlusion order (occlusion=sample): an order bit per node from the design sample,
+// bvh-design's occlusion order (occlusion=sample): an order per node and direction from the sample,
 // on the designed tree or on bvh-sah's, and of those and bvh-sah walked front to back the one its
 // own walk of the sample prices cheapest.
 #include <gtest/gtest.h>
@@ -28,7 +28,7 @@ double ops_on_sample(const Hierarchy& h, const RaySample& smp) {
         const TraceResult r = trace_rays(h, rays, o);
         sum += r.counters;
     }
-    return UnitCosts::named("unit").scalar(measured_cost(sum));  // per ray: sum.rays of them
+    return UnitCosts{}.scalar(measured_cost(sum));  // unit costs, per ray: sum.rays of them
 }
 
 TEST(DesignOcclusion, TheOrderChosenCountsNoMoreOnItsSampleThanFrontToBack) {

@@ -3,8 +3,9 @@
 // ends, that meet the child's box), blended with the surface-area ratio where few segments reach
 // the node; a node stays a leaf where no split pays; and the order in which occlusion rays enter
 // a node's children: front to back or leaf children first, whichever the model predicts cheaper
-// on the sample (or, with occlusion=sample, an order bit per node from the sample, on the designed
-// tree or on bvh-sah's, whichever its own walk prices cheaper on the sample: occlusion_order.hpp).
+// on the sample (or, with occlusion=sample, an order per node and direction from the sample, on the
+// designed tree or on bvh-sah's, whichever its own walk prices cheaper on the sample:
+// occlusion_order.hpp).
 // Otherwise traversed as every BVH (../bvh/bvh.hpp).
 #include <algorithm>
 #include <unordered_map>
@@ -237,9 +238,9 @@ const Registration reg{
              "occlusion", "auto", {"auto", "near", "leaves", "sample"},
              "order in which occlusion rays enter a node's children: near (front to back, as every BVH), leaves "
              "(leaf children first, then front to back), auto (of near and leaves, the one the model predicts "
-             "cheaper on the sample), or sample (the child likelier to end the ray per primitive first, an order "
-             "bit per node, on the designed tree or bvh-sah's, whichever its walk prices cheaper on the sample; outside "
-             "the model's exact replay)"));
+             "cheaper on the sample), or sample (the child likelier to end the ray per primitive first, by node and "
+             "by the way the ray crosses it, on the designed tree or bvh-sah's, or bvh-sah front to back, whichever "
+             "its walk prices cheapest on the sample; outside the model's exact replay)"));
          p.push_back(ParamSpec::real("trust", "32", 0, 1e30,
                                      "sample segments at a node at which sample and surface area weigh alike "
                                      "(large: the surface area heuristic)"));
@@ -296,10 +297,9 @@ const Registration reg{
          // by its own traversal of the sample (the model's replay goes front to back and would
          // not see an order's gain); a tie keeps the designed splits.
          const designing::SampleReplay replay(s, in.sample, in.costs);
-         std::vector<std::uint8_t> sah_bits = occlusion_bits(by_sah->data(), s, in.sample);
-         auto sah_ordered = std::make_unique<DesignedBvh>(s, by_sah->data(), std::move(sah_bits));
-         std::vector<std::uint8_t> designed_bits = occlusion_bits(designed_tree, s, in.sample);
-         auto designed_ordered = std::make_unique<DesignedBvh>(s, std::move(designed_tree), std::move(designed_bits));
+         auto sah_ordered = std::make_unique<DesignedBvh>(s, by_sah->data(), occlusion_bits(by_sah->data(), s, in.sample));
+         std::vector<std::uint8_t> designed_order = occlusion_bits(designed_tree, s, in.sample);
+         auto designed_ordered = std::make_unique<DesignedBvh>(s, std::move(designed_tree), std::move(designed_order));
          const double c_designed = replay.time(*designed_ordered), c_sah_ordered = replay.time(*sah_ordered),
                       c_sah = replay.time(*by_sah);
          if (c_sah < c_designed && c_sah <= c_sah_ordered) return by_sah;

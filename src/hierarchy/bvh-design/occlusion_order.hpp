@@ -12,7 +12,7 @@
 
 namespace rtcost::bvh {
 
-/// The order bytes of any binary BVH `d` over `s` (DesignedBvh's right_first) from `sample`'s
+/// The order bytes of any binary BVH `d` over `s` (DesignedBvh's order) from `sample`'s
 /// occlusion rays: at each binary node, for the rays going each way along the node's axis (the one
 /// its children's centres lie furthest apart on), the child entered first is the one more of those
 /// that reach it (their segments clipped where their search ends) end in, per primitive below it;
@@ -23,18 +23,16 @@ std::vector<std::uint8_t> occlusion_bits(const BvhData& d, const Scene& s, const
 
 class DesignedBvh final : public HierarchyImpl<DesignedBvh> {
 public:
-    /// `right_first[i]`: interior node i's order byte (occlusion_bits).
-    DesignedBvh(const Scene& s, BvhData data, std::vector<std::uint8_t> right_first)
-        : HierarchyImpl(s), bvh_(s, "bvh-design", std::move(data), true), right_first_(std::move(right_first)) {}
+    /// `order[i]`: interior node i's order byte (occlusion_bits).
+    DesignedBvh(const Scene& s, BvhData data, std::vector<std::uint8_t> order)
+        : HierarchyImpl(s), bvh_(s, "bvh-design", std::move(data), true), order_(std::move(order)) {}
 
     std::string_view name() const override { return "bvh-design"; }
     bool emit_model(ModelSink& sink) const override { return bvh_.emit_model(sink); }
-    const std::vector<std::uint8_t>& right_first() const { return right_first_; }
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        if constexpr (Q == Query::Any) return occlusion(ray, hit, counting, RealPrimTest{scene()});
-        else return bvh_.template trace<C, Q>(ray, hit, counting);
+        return trace_with<C, Q>(ray, hit, counting, RealPrimTest{scene()});
     }
 
     /// The traversal with the caller's primitive test (design/replay.hpp prices it on a sample).
@@ -47,7 +45,7 @@ public:
 protected:
     StructureStats compute_structure() const override {
         StructureStats st = bvh_.structure();
-        st.bytes += right_first_.size();
+        st.bytes += order_.size();
         return st;
     }
 
@@ -86,7 +84,7 @@ private:
                         next[nn++] = {n.index + k, e.depth + 1};
                 }
                 if (nn == 2) {
-                    const std::uint8_t b = right_first_[e.node];
+                    const std::uint8_t b = order_[e.node];
                     if ((b >> (2 + ri.neg[b & 3])) & 1) std::swap(next[0], next[1]);
                 }
                 if (nn > 0) {
@@ -103,7 +101,7 @@ private:
     }
 
     Bvh bvh_;
-    std::vector<std::uint8_t> right_first_;
+    std::vector<std::uint8_t> order_;
 };
 
 }  // namespace rtcost::bvh

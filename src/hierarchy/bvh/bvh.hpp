@@ -75,14 +75,9 @@ public:
     bool any_leaves_first() const { return any_leaves_first_; }
 
     /// For another walk of the same nodes (bvh-design's occlusion order): leaf `n`'s primitive
-    /// tests as this BVH's own walk makes them, on its triangle copies in leaf order with the
-    /// ray's shear `shear` (shear_of), counted alike; true when an any-hit query ends. With a
-    /// primitive test supplied by the caller as trace_with takes one.
-    template <class C, Query Q>
-    bool test_leaf_of(const Node& n, const Ray& ray, const RayShear& shear, Hit& hit, C& counting, bool& found) const {
-        RealPrimTest test{*scene_};
-        return test_leaf<C, Q>(n.index, n.count, ray, shear, hit, counting, found, test);
-    }
+    /// tests as this BVH's own walk makes them (with RealPrimTest, on its triangle copies in leaf
+    /// order with the ray's shear `shear`, shear_of), counted alike; true when an any-hit query
+    /// ends. `test` as trace_with takes it.
     template <class C, Query Q, class PrimTest>
     bool test_leaf_of(const Node& n, const Ray& ray, const RayShear& shear, Hit& hit, C& counting, bool& found,
                       PrimTest& test) const {
