@@ -45,5 +45,37 @@ TEST(Cull, EveryHierarchyFindsTheNearestOfHitsAFloatApartAtASharedVertex) {
     }
 }
 
+// Rays from hard_rays through a vertex of tetra's triangles that lies in a kd-sah plane: the
+// cell before the plane holds a triangle met at 0.99999994, the cell after it one met a float
+// nearer. kd-trees ended the search at the first cell, its hit inside the (widened) plane
+// crossing, until a leaf ended it only when cull_bound(hit) lies inside (kd::KdTree).
+TEST(Cull, EveryHierarchyFindsTheNearerHitJustBeyondAKdPlane) {
+    struct Case {
+        int level;
+        float r[6];
+    };
+    const Case cases[] = {
+        {4, {0x1.ecc1ep+0f, -0x1.d851ecp-1f, -0x1.a2b272p+0f, -0x1.3660fp+1f, 0x1.6c28f6p+0f, 0x1.4564e4p-1f}},
+        {3, {-0x1.78077p-2f, 0x1.f12898p-1f, -0x1.312a1p-3f, 0x1.bc03b8p-1f, 0x1.daedp-6f, 0x1.4c4a84p-1f}},
+        {5, {0x1.403a98p+0f, 0x1.311158p-1f, -0x1.ed738p-6f, -0x1.203a98p+0f, -0x1.7888acp+0f, 0x1.ed738p-6f}},
+        {5, {0x1.6e03f8p-1f, 0x1.d4e548p+0f, 0x1.a18168p+0f, -0x1.9701fcp+0f, -0x1.a9ca9p-1f, -0x1.40c0b4p+1f}},
+        {5, {-0x1.e4db6p-4f, 0x1.b020cp-1f, 0x1.5ff828p-1f, 0x1.e4db6p-4f, -0x1.7020cp-1f, -0x1.8ffc14p+0f}},
+        {5, {-0x1.c35d98p-2f, 0x1.82d384p+0f, -0x1.3af226p+0f, 0x1.a1aeccp-1f, -0x1.a2d384p+0f, 0x1.ebc898p-2f}},
+    };
+    for (const Case& c : cases) {
+        const Scene s = builtin_scene("tetra", c.level);
+        const std::vector<Ray> rays{Ray{{c.r[0], c.r[1], c.r[2]}, {c.r[3], c.r[4], c.r[5]}, 0.0f, kInf}};
+        const Hit want = closest_hits(*build_hierarchy(s, "brute"), rays)[0];
+        ASSERT_TRUE(want.hit());
+        EXPECT_EQ(want.t, 0.999999881f);  // a float before 0.99999994
+        for (const auto& [name, set] : registered_variants(kTestHits)) {
+            if (name == "embree") continue;  // as above
+            const Hit got = closest_hits(*build_hierarchy(s, name, set), rays)[0];
+            EXPECT_EQ(got.t, want.t) << name << " " << ::testing::PrintToString(set) << " tetra:" << c.level;
+            EXPECT_EQ(got.prim, want.prim) << name << " " << ::testing::PrintToString(set) << " tetra:" << c.level;
+        }
+    }
+}
+
 }  // namespace
 }  // namespace rtcost::test

@@ -129,7 +129,7 @@ public:
 
     Probe(const ModelTree& t, const Scene& s, PrimOracle& oracle, Query q)
         : t_(t), s_(s), oracle_(oracle), any_(q == Query::Any), cull_(q == Query::Closest && t.cull),
-          walks_(walks_edges(s)), tally_(t.nodes.size()) {}
+          cuts_(cull_ && t.family != ModelFamily::Kd), walks_(walks_edges(s)), tally_(t.nodes.size()) {}
 
     /// One training ray; false when it misses the root.
     bool run(const Ray& ray) {
@@ -137,6 +137,7 @@ public:
         ri_ = RayInv(ray);
         hit_ = Hit{};
         found_ = false;
+        leaf_t1_ = kInf;
         const Segment whole{ray.tmin, ray.tmax};
         const Segment root = t_.gated ? clip_segment(ri_, t_.nodes[0].region, whole) : whole;
         if (root.empty()) return false;
@@ -149,18 +150,23 @@ public:
 private:
     // Nothing more is searched: an any-hit query has its hit.
     bool done() const { return any_ && found_; }
-    // A closest-hit traversal skips a segment that starts at or beyond the nearest hit so far.
-    bool beyond(const Segment& s) const { return cull_ && s.t0 >= bound(); }
+    // A closest-hit traversal skips a segment that starts at or beyond the nearest hit so far (a
+    // kd-tree's never does: it stops at the leaf that holds the hit, kd_ends).
+    bool beyond(const Segment& s) const { return cuts_ && s.t0 >= bound(); }
+    // A kd-tree's traversal ends after a cell whose segment ends at `t1` once the nearest hit's
+    // bound lies inside it (kd::KdTree).
+    bool kd_ends(float t1) const { return found_ && bound() <= t1; }
     // What the traversal culls by: the nearest hit, or a little beyond it (ModelFlags::cull_widened).
     float bound() const { return t_.cull_widened ? cull_bound(hit_.t) : hit_.t; }
     // A child's segment, cut at the nearest hit so far when the traversal culls by it; empty
     // where the traversal does not enter it (model::meets), and where it starts at or beyond
     // that hit: no traversal enters a region there (a BVH pops it, a subdivision has stopped at
     // the cell before), and a region that begins in the hit's plane (gears' coplanar faces)
-    // is not entered either.
+    // is not entered either. A kd-tree's traversal cuts nothing: its cells' segments are
+    // whole, and it ends at a leaf (kd_ends).
     Segment child(std::uint32_t c, const Segment& s) const {
         Segment x = clip_segment(ri_, t_.nodes[c].region, s);
-        if (cull_ && bound() < x.t1) x.t1 = bound();
+        if (cuts_ && bound() < x.t1) x.t1 = bound();
         if (!meets(t_, s, x) || beyond(x)) x = Segment{kInf, -kInf};
         return x;
     }
@@ -176,6 +182,7 @@ private:
         }
         ty.gated += 1;
         if (m.leaf) {
+            leaf_t1_ = s.t1;
             for (std::uint32_t k = 0; k < m.count; ++k) {
                 const std::uint32_t id = t_.prims[m.first + k];
                 ty.tests[static_cast<int>(s_.kind(id))] += 1;
@@ -211,12 +218,13 @@ private:
                 bool ends = done() || beyond(far);
                 // A kd-tree's traversal widens the near side's end by a relative 4e-7 against
                 // rounding (kd::KdTree), so a hit that far past the plane (a face lying in it)
-                // ends the search before the far side. Not for a ray in the plane: both sides
+                // ends the search before the far side, unless its cull_bound lies beyond. Not for a ray in the plane: both sides
                 // then cover the same stretch, and the traversal searches both.
                 if (!ends && cull_ && t_.family == ModelFamily::Kd && m.axis >= 0 && m.axis < 3 &&
                     std::fabs(ri_.inv[m.axis]) < kInf) {
-                    const float t1 = (left_first ? sl : sr).t1;
-                    ends = hit_.t <= t1 * (t1 > 0 ? 1.0000004f : 0.9999996f);
+                    // The traversal decides at the last leaf it searched, whose segment kd-median's
+                    // node boxes may have narrowed below the near side's.
+                    ends = kd_ends(leaf_t1_ * (leaf_t1_ > 0 ? 1.0000004f : 0.9999996f));
                 }
                 tally_[near].first_ends += ends;
                 if (!ends) visit(left_first ? m.first + 1 : m.first, far);
@@ -242,19 +250,21 @@ private:
                 if (!beyond(sc)) visit(met[k].second, sc);
             }
         }
-        ty.ended += done() || (cull_ && hit_.t <= s.t1);
+        ty.ended += done() || (cull_ && (cuts_ ? hit_.t <= s.t1 : kd_ends(s.t1)));
     }
 
     const ModelTree& t_;
     const Scene& s_;
     PrimOracle& oracle_;
     const bool any_, cull_;
+    const bool cuts_;   // culling cuts segments at the nearest hit (all but kd-trees)
     const bool walks_;  // some polygon's test walks edges (walks_edges)
     std::vector<Tally> tally_;
     const Ray* ray_ = nullptr;
     RayInv ri_{Ray{}};
     Hit hit_;
     bool found_ = false;
+    float leaf_t1_ = kInf;  // the segment's end in the last leaf searched
 };
 
 }  // namespace

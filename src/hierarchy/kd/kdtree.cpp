@@ -117,6 +117,7 @@ StructureStats KdTree::compute_structure() const {
 bool KdTree::emit_model(ModelSink& sink) const {
     ModelFlags f(ModelFamily::Kd, {.interior_box = 1, .interior_plane = 1});  // the paper's kd node
     f.per_ray_box = 1;
+    f.cull_widened = true;  // a leaf ends the search only when cull_bound(hit) is inside it
     if (!sink.begin(f) || d_.nodes.empty()) return true;
     auto emit = [&](auto&& self, std::uint32_t i, const Box3& region) -> void {
         const Node& n = d_.nodes[i];

@@ -11,12 +11,14 @@
 // Traversal (front to back, explicit stack): the ray's segment [t0, t1] inside the current cell
 // is split at the plane; the near child gets [t0, ts], the far child [ts, t1] (closed: both
 // when ts lies on an end), each widened by a relative 4e-7 so that rounding never loses a cell
-// the ray really meets (a hit may then end the search up to 4e-7 beyond its cell: a tie). A ray
-// with no direction component on the split axis goes to the side holding its origin, and to
-// both sides (left first) when it lies in the plane. A leaf ends the search when the closest hit
-// so far lies at t <= the leaf's t1 (a hit further on may lie in a later cell behind a nearer
-// one), except on the left of a plane the ray lies in: both sides then cover the same stretch of
-// the ray, and although in exact arithmetic every primitive the ray meets there touches the
+// the ray really meets. A ray with no direction component on the split axis goes to the side
+// holding its origin, and to both sides (left first) when it lies in the plane. A leaf ends the
+// search when the closest hit so far lies inside its segment by a margin: cull_bound(t) <= t1
+// (a hit further on may lie in a later cell behind a nearer one, and a hit within a relative
+// 2^-16 of the exit may not be the nearest: a face that only starts beyond the plane, met where
+// the ray crosses it, can round a float nearer -- rays through tetra's shared vertices did).
+// The exception is the left of a plane the ray lies in: both sides then cover the same stretch
+// of the ray, and although in exact arithmetic every primitive the ray meets there touches the
 // plane (so is on both sides), the float intersection tests also report hits a rounding error
 // off the plane -- planes sit exactly at (or one float beside) primitive edges -- so the right
 // side is searched before the search may end.
@@ -191,9 +193,11 @@ private:
                         if constexpr (Q == Query::Any) return true;
                     }
                 }
-                // A hit up to the cell's exit (closed) is in this cell: nothing later is nearer.
+                // A hit before the cell's exit is in this cell: nothing later is nearer. Within a
+                // relative 2^-16 of the exit (cull_bound) the next cell is searched too: a face
+                // that only starts there (beyond the plane) may be met a float or two nearer.
                 if constexpr (Q != Query::All) {
-                    if (e.may_end && hit.t <= e.t1) return found;
+                    if (e.may_end && cull_bound(hit.t) <= e.t1) return found;
                 }
                 if (sp == 0) return found;
                 e = stack[--sp];
