@@ -424,12 +424,17 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         res.rows.push_back(std::move(row));
     }
     if (opt.interleave_timing) {
-        // Rounds of one pass per hierarchy until every one has had its share.
+        // Rounds of one pass per hierarchy until every one has had its share. Each round starts
+        // one hierarchy later than the one before, so that none always follows the same one (a
+        // pass finds the caches holding the previous pass's structure, and the scene and rays
+        // they share warm or not).
         if (opt.on_step) opt.on_step("timing (interleaved)");
         std::vector<PassTimes> times(timed_later.size());
-        for (bool more = true; more;) {
+        std::size_t round = 0;
+        for (bool more = true; more; ++round) {
             more = false;
-            for (std::size_t i = 0; i < timed_later.size(); ++i) {
+            for (std::size_t j = 0; j < timed_later.size(); ++j) {
+                const std::size_t i = (j + round) % timed_later.size();
                 if (!times[i].more(opt)) continue;
                 const Timed& t = timed_later[i];
                 times[i].add(trace_ray_set(*t.h, t.subset.rays.empty() ? test : t.subset, t.to, opt.occlusion));
