@@ -8,12 +8,14 @@
 // occlusion_order.hpp).
 // Otherwise traversed as every BVH (../bvh/bvh.hpp).
 #include <algorithm>
+#include <optional>
 #include <unordered_map>
 
 #include "../bvh/topdown.hpp"
 #include "boxes_met.hpp"
 #include "design/replay.hpp"
 #include "occlusion_order.hpp"
+#include "split_candidates.hpp"
 #include "rtcost/design.hpp"
 
 namespace rtcost::bvh {
@@ -27,86 +29,10 @@ struct DesignOptions {
     int max_depth = 64;
     int bins = 16;
     int candidates = 8;   ///< SAH-cheapest splits re-weighed with the sample
+    int sweep = 2;        ///< and this many SAH-cheapest of every split of the centroid-sorted primitives
     double trust = 32;    ///< sample segments at which the sample and the surface area weigh alike
 };
 
-struct Cut {
-    int axis = -1;
-    int at = 0;           // first bin on the right
-    float sah = kInf;     // A_L N_L + A_R N_R
-    Box3 left, right;
-    std::uint32_t n_left = 0, n_right = 0;
-};
-
-// Buffers of binned_cuts, reused from node to node.
-struct CutScratch {
-    struct Bin {
-        Box3 box;
-        std::uint32_t n = 0;
-    };
-    std::vector<Bin> bins;
-    std::vector<Box3> suffix;
-    std::vector<std::uint32_t> suffix_n;
-    std::vector<Cut> all;
-    std::vector<std::uint32_t> order;
-};
-
-// The `keep` cheapest of every bin boundary on every axis by surface-area cost, cheapest first
-// (ties in the order of generation: axis, then bin), into `cuts`.
-void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end, const PrimInfo& info,
-                 const Box3& cb, int nbins, std::size_t keep, CutScratch& sc, std::vector<Cut>& cuts) {
-    sc.all.clear();
-    sc.bins.assign(3 * nbins, CutScratch::Bin{});
-    sc.suffix.resize(nbins + 1);
-    sc.suffix_n.resize(nbins + 1);
-    // One pass over the primitives fills the three axes' bins.
-    float lo[3], scale[3];
-    for (int axis = 0; axis < 3; ++axis) {
-        lo[axis] = cb.lo[axis];
-        const float ext = cb.hi[axis] - lo[axis];
-        scale[axis] = ext > 0 ? nbins / ext : 0;
-    }
-    for (std::uint32_t i = begin; i < end; ++i) {
-        const Vec3& c = info.centroids[ids[i]];
-        const Box3& bounds = info.bounds[ids[i]];
-        for (int axis = 0; axis < 3; ++axis) {
-            const int b = std::min(nbins - 1, static_cast<int>((c[axis] - lo[axis]) * scale[axis]));
-            CutScratch::Bin& bin = sc.bins[axis * nbins + b];
-            bin.box.extend(bounds);
-            ++bin.n;
-        }
-    }
-    for (int axis = 0; axis < 3; ++axis) {
-        if (!(cb.hi[axis] - lo[axis] > 0)) continue;
-        const CutScratch::Bin* bins = sc.bins.data() + axis * nbins;
-        sc.suffix[nbins] = Box3{};
-        sc.suffix_n[nbins] = 0;
-        for (int b = nbins - 1; b >= 0; --b) {
-            sc.suffix[b] = sc.suffix[b + 1];
-            sc.suffix[b].extend(bins[b].box);
-            sc.suffix_n[b] = sc.suffix_n[b + 1] + bins[b].n;
-        }
-        Box3 prefix;
-        std::uint32_t n = 0;
-        for (int b = 0; b + 1 < nbins; ++b) {
-            prefix.extend(bins[b].box);
-            n += bins[b].n;
-            if (n == 0 || sc.suffix_n[b + 1] == 0) continue;
-            sc.all.push_back({axis, b + 1, prefix.area() * n + sc.suffix[b + 1].area() * sc.suffix_n[b + 1], prefix,
-                              sc.suffix[b + 1], n, sc.suffix_n[b + 1]});
-        }
-    }
-    // The first `keep` of a stable sort by cost: ties to the earlier generated.
-    keep = std::min(keep, sc.all.size());
-    sc.order.resize(sc.all.size());
-    for (std::uint32_t i = 0; i < sc.order.size(); ++i) sc.order[i] = i;
-    std::partial_sort(sc.order.begin(), sc.order.begin() + static_cast<std::ptrdiff_t>(keep), sc.order.end(),
-                      [&](std::uint32_t x, std::uint32_t y) {
-                          return sc.all[x].sah < sc.all[y].sah || (sc.all[x].sah == sc.all[y].sah && x < y);
-                      });
-    cuts.clear();
-    for (std::size_t i = 0; i < keep; ++i) cuts.push_back(sc.all[sc.order[i]]);
-}
 
 BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions& o) {
     PrimInfo info(s);
@@ -141,6 +67,13 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
     std::vector<std::vector<std::uint32_t>> met;
     CutScratch scratch;
     std::vector<Cut> cuts;
+    // The sweep's centroid orders, kept only where a sample weighs the cuts.
+    std::optional<AxisOrders> orders;
+    if (o.sweep > 0 && o.trust < kNoTrust) {
+        std::vector<std::uint32_t> all(s.size());
+        for (std::uint32_t i = 0; i < s.size(); ++i) all[i] = i;
+        orders.emplace(all, info);
+    }
     BvhData data = build_topdown(s, info, [&](std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
                                       const Box3& box, int depth) -> std::uint32_t {
         std::vector<std::uint32_t> rays = std::move(reaching[begin]);
@@ -156,12 +89,14 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
         const double w = o.trust >= kNoTrust ? 0 : m / (m + o.trust);
         binned_cuts(ids, begin, end, info, cb, o.bins, w == 0 ? 1 : static_cast<std::size_t>(o.candidates), scratch,
                     cuts);
+        // Without sample weight the SAH's own bins alone, so that the design falls back to its tree exactly.
+        if (w > 0 && o.sweep > 0) swept_cuts(*orders, begin, end, info, static_cast<std::size_t>(o.sweep), scratch, cuts);
         // Expected cost below this node, per ray reaching it: a leaf tests every primitive; a split
         // tests both child boxes and each child's primitives as often as the child is entered.
         double best = kInf;
         int chosen = -1;
         std::vector<std::uint32_t> best_left, best_right;
-        const int k = std::min<int>(w == 0 ? 1 : o.candidates, static_cast<int>(cuts.size()));
+        const int k = w == 0 ? std::min<int>(1, static_cast<int>(cuts.size())) : static_cast<int>(cuts.size());
         // The segments meeting each candidate's left and right box (met[2c], met[2c + 1]), as
         // meets() finds them, all boxes of a ray at once.
         if (w > 0) {
@@ -207,6 +142,10 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
             mid = begin + n / 2;
             std::nth_element(ids.begin() + begin, ids.begin() + mid, ids.begin() + end, by_axis0);
             best_left = best_right = rays;
+        } else if (cuts[chosen].swept) {
+            mid = begin + static_cast<std::uint32_t>(cuts[chosen].at);
+            const std::span<const std::uint32_t> sorted = orders->of(cuts[chosen].axis, begin, end);
+            std::copy(sorted.begin(), sorted.end(), ids.begin() + begin);
         } else {
             const Cut& cut = cuts[chosen];
             const float lo = cb.lo[cut.axis], scale = o.bins / (cb.hi[cut.axis] - lo);
@@ -217,6 +156,7 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
             mid = static_cast<std::uint32_t>(it - ids.begin());
             if (w == 0) best_left = best_right = {};
         }
+        if (orders) orders->split(ids, begin, mid, end);
         reaching[begin] = std::move(best_left);
         reaching[mid] = std::move(best_right);
         return mid;
@@ -232,6 +172,9 @@ const Registration reg{
          p.push_back(ParamSpec::integer("max_prims", "32", 1, 1 << 20, "largest leaf (bigger nodes are always split)"));
          p.push_back(ParamSpec::integer("max_depth", "64", 0, kMaxDepth, "deepest leaf"));
          p.push_back(ParamSpec::integer("bins", "16", 2, 256, "bins per axis"));
+         p.push_back(ParamSpec::integer("sweep", "2", 0, 3 * 256,
+                                        "and the surface-area-cheapest splits of a sweep over the centroid-sorted "
+                                        "primitives weighed again with the sample"));
          p.push_back(ParamSpec::integer("candidates", "8", 1, 3 * 256,
                                         "surface-area-cheapest splits weighed again with the sample"));
          p.push_back(ParamSpec::choice(
@@ -251,6 +194,7 @@ const Registration reg{
          o.max_prims = static_cast<int>(p.integer("max_prims"));
          o.max_depth = static_cast<int>(p.integer("max_depth"));
          o.bins = static_cast<int>(p.integer("bins"));
+         o.sweep = static_cast<int>(p.integer("sweep"));
          o.candidates = static_cast<int>(p.integer("candidates"));
          o.trust = p.real("trust");
          const DesignInput in = draw_design_input(s, p);
@@ -265,12 +209,14 @@ const Registration reg{
          const auto* reference = dynamic_cast<const Bvh*>(in.reference.get());
          const bool as_reference = reference && usual.max_depth == sah_defaults.max_depth && usual.bins == sah_defaults.bins;
          auto by_sah = std::make_unique<Bvh>(s, "bvh-design", as_reference ? reference->data() : build_sah(s, usual), true);
-         if (!p.is("occlusion", "sample")) {
+         const bool any_query =
+             std::find(in.sample.queries.begin(), in.sample.queries.end(), Query::Any) != in.sample.queries.end();
+         // Without occlusion rays an order for them has nothing to gain, and the plain BVH is
+         // faster than DesignedBvh on the same tree (3% on sombrero's camera rays; not understood).
+         if (!p.is("occlusion", "sample") || !any_query) {
              auto designed = std::make_unique<Bvh>(s, "bvh-design", std::move(designed_tree), true);
              // Each tree in the order asked for, or in the order the model predicts cheaper on
              // the sample (only its occlusion rays can tell the two apart).
-             const bool any_query = std::find(in.sample.queries.begin(), in.sample.queries.end(), Query::Any) !=
-                                    in.sample.queries.end();
              const bool try_near = !p.is("occlusion", "leaves");
              const bool try_leaves = p.is("occlusion", "leaves") || (p.is("occlusion", "auto") && any_query);
              struct Choice {
