@@ -32,7 +32,7 @@ struct CutScratch {
     std::vector<std::uint32_t> suffix_n;
     std::vector<Cut> all;
     std::vector<std::uint32_t> order;
-    std::vector<Box3> right;
+    std::vector<float> right_area;
 };
 
 // The `keep` cheapest of `sc.all` by surface-area cost, cheapest first (ties in the order of
@@ -102,28 +102,34 @@ inline void swept_cuts(const AxisOrders& orders, std::uint32_t begin, std::uint3
                        std::size_t keep, CutScratch& sc, std::vector<Cut>& cuts) {
     const std::uint32_t n = end - begin;
     if (keep == 0 || n < 2) return;
-    sc.right.resize(n + 1);
+    sc.right_area.resize(n + 1);
     // The cheapest `keep` so far, cheapest first; a tie keeps the earlier (axis, then position),
-    // as binned_cuts orders its ties. Only they are stored: a node has 3 (n - 1) splits.
+    // as binned_cuts orders its ties. Only they are stored, and their boxes made at the end: a
+    // node has 3 (n - 1) splits.
     const std::size_t first = cuts.size();
     for (int axis = 0; axis < 3; ++axis) {
         const std::span<const std::uint32_t> sorted = orders.of(axis, begin, end);
-        sc.right[n] = Box3{};
-        for (std::uint32_t i = n; i-- > 0;) {
-            sc.right[i] = sc.right[i + 1];
-            sc.right[i].extend(info.bounds[sorted[i]]);
+        Box3 right;
+        for (std::uint32_t i = n; i-- > 1;) {
+            right.extend(info.bounds[sorted[i]]);
+            sc.right_area[i] = right.area();
         }
         Box3 left;
         for (std::uint32_t i = 1; i < n; ++i) {
             left.extend(info.bounds[sorted[i - 1]]);
-            const float sah = left.area() * i + sc.right[i].area() * (n - i);
+            const float sah = left.area() * i + sc.right_area[i] * (n - i);
             const std::size_t kept = cuts.size() - first;
             if (kept == keep && !(sah < cuts.back().sah)) continue;
             if (kept == keep) cuts.pop_back();
             auto at = cuts.end();
             while (at != cuts.begin() + first && sah < (at - 1)->sah) --at;
-            cuts.insert(at, Cut{axis, static_cast<int>(i), true, sah, left, sc.right[i], i, n - i});
+            cuts.insert(at, Cut{axis, static_cast<int>(i), true, sah, Box3{}, Box3{}, i, n - i});
         }
+    }
+    for (std::size_t c = first; c < cuts.size(); ++c) {
+        Cut& cut = cuts[c];
+        const std::span<const std::uint32_t> sorted = orders.of(cut.axis, begin, end);
+        for (std::uint32_t i = 0; i < n; ++i) (i < cut.n_left ? cut.left : cut.right).extend(info.bounds[sorted[i]]);
     }
 }
 
