@@ -32,7 +32,7 @@ def scene_path(name):
 
 def run(binary, scene, dist, families, size, sample, costs=None):
     cmd = ["taskset", "-c", "0", binary, "design", scene, "--rays", dist, "--size", size,
-           "--family", families, "--sample", str(sample), "--json", "--quiet"] + (["--costs", costs] if costs else [])
+           "--family", families, "--sample", str(sample), "--control", "--json", "--quiet"] + (["--costs", costs] if costs else [])
     start = time.time()
     out = subprocess.run(cmd, check=True, capture_output=True, text=True).stdout
     return json.loads(out), time.time() - start
@@ -119,12 +119,18 @@ def targets(rows, raw_sweeps):
         mean_ns = sum(x for _, x, _ in spd) / len(spd)
         mean_ops = sum(x for _, _, x in spd) / len(spd)
         worst_ns = min(gain(r, "ns_per_ray") for _, _, r in bvh)
+        controls = [r["control_gain"] for _, _, r in bvh if "control_gain" in r]
         worst_ops = min(gain(r, "measured") for _, _, r in bvh)
         out.append(f"- bvh-design at least 10% faster than bvh-sah on `spd` rays on average over the SPD scenes: "
                    f"ns {100 * mean_ns:+.1f}%, operations {100 * mean_ops:+.1f}% ({'met' if mean_ns >= 0.1 else 'not met'} in ns, "
                    f"{'met' if mean_ops >= 0.1 else 'not met'} in operations); no scene and distribution more than 3% slower: "
                    f"worst ns {100 * worst_ns:+.1f}%, worst operations {100 * worst_ops:+.1f}% "
                    f"({'met' if worst_ns >= -0.03 else 'not met'} in ns, {'met' if worst_ops >= -0.03 else 'not met'} in operations).")
+        if controls:
+            slower = sum(1 for x in controls if x < -0.03)
+            out.append(f"- the A/A control on the same {len(controls)} bvh rows (a second copy of bvh-sah against bvh-sah): "
+                       f"from {100 * min(controls):+.1f}% to {100 * max(controls):+.1f}%, more than 3% slower on {slower}; "
+                       f"a gain of a few percent either way is within this run's noise.")
     grid = [(sc, gain(r, "ns_per_ray"), gain(r, "measured")) for sc, d, doc, r in rows
             if r["family"] == "grid" and d == "spd" and sc.endswith(".nff")]
     if grid:
@@ -208,20 +214,24 @@ def main():
              "operations per ray on the design sample (segments estimator); `measured`: counted operations "
              "per ray on the test rays (unit costs); `ns`: measured single-thread ns per ray on the test "
              "rays; `gain`: 1 - designed ns / yardstick ns; `build`: seconds, the designed one's including "
-             "drawing its sample (the design time). The designs minimise "
+             "drawing its sample (the design time); `A/A`: 1 - control ns / yardstick ns, the control being a "
+             "second copy of the yardstick built and timed first, where the designed one is otherwise (`rtcost "
+             "design --control`): this run's noise on that row. The designs minimise "
              + (f"the ns per operation of `{a.costs}`" if a.costs else
                 "each family's default costs: typical ns per operation (rtcost's built-in `UnitCosts::typical`, "
                 "the time model fitted on the twelve scenes of docs/time-model.md, with its step, cache and "
                 "polygon-edge terms) for bvh and kd, operation counts for grid, octree and bsp (`ops`: a polygon "
                 "edge walked counts as the share of a test the time model gives it, about a quarter)") + ".", "",
-             "| scene | rays | family | sample | test rays | build s (design / yardstick) | predicted ops | measured ops | ns per ray | Embree ns | gain |",
-             "|---|---|---|---|---|---|---|---|---|---|---|"]
+             "| scene | rays | family | sample | test rays | build s (design / yardstick) | predicted ops | measured ops | ns per ray | Embree ns | gain | A/A |",
+             "|---|---|---|---|---|---|---|---|---|---|---|---|"]
+    def aa(r):
+        return f"{100 * r['control_gain']:+.1f}%" if "control_gain" in r else "-"
     for scene, dist, doc, r in rows:
         b, p, m, n = r["build_seconds"], r["predicted"], r["measured"], r["ns_per_ray"]
         lines.append(f"| {scene} | {dist} | {r['designed']} vs {r['yardstick']} | {doc['sample']} | {doc['test_rays']} | "
                      f"{b['designed']:.3f} / {b['yardstick']:.3f} | {p['designed']:.1f} / {p['yardstick']:.1f} | "
                      f"{m['designed']:.1f} / {m['yardstick']:.1f} | {n['designed']:.0f} / {n['yardstick']:.0f} | "
-                     f"{n['embree']:.0f} | {100 * r['gain']:+.1f}% |")
+                     f"{n['embree']:.0f} | {100 * r['gain']:+.1f}% | {aa(r)} |")
     # Per family and distribution: mean gain and worst case.
     lines += ["", "## Gain by family and distribution", "", "| family | rays | scenes | mean gain | worst | best |",
               "|---|---|---|---|---|---|"]

@@ -357,6 +357,33 @@ TEST(Design, DesignReportsEachFamilyOnDisjointRays) {
     EXPECT_EQ(j["results"][0]["family"], "grid");
     EXPECT_EQ(j["results"][0]["designed"], "grid-design");
     EXPECT_EQ(j["results"][0]["set"][0], "rays=spd");
+    EXPECT_EQ(r.rows[0].control_ns, 0);  // not asked for
+    EXPECT_FALSE(j["results"][0]["ns_per_ray"].contains("control"));
+}
+
+// --control: a second copy of each yardstick is timed, its figures beside the others; the
+// designed, yardstick and Embree rows keep their places (the control is the evaluation's first).
+TEST(Design, ControlTimesASecondCopyOfTheYardstick) {
+    const Scene s = builtin_scene("balls", 2);
+    DesignOptions o;
+    o.rays.name = "camera";
+    o.rays.size = "24x24";
+    o.sample = 128;
+    o.families = {"grid", "bvh"};
+    o.control = true;
+    const DesignResult r = design(s, o);
+    ASSERT_EQ(r.rows.size(), 2u);
+    const nlohmann::json j = to_json(r);
+    for (std::size_t i = 0; i < r.rows.size(); ++i) {
+        const DesignRow& row = r.rows[i];
+        EXPECT_GT(row.control_ns, 0) << row.family;
+        EXPECT_GT(row.embree_ns, 0) << row.family;
+        EXPECT_EQ(row.designed.substr(0, row.designed.find(':')), row.family + "-design");
+        EXPECT_EQ(j["results"][i]["ns_per_ray"]["control"], row.control_ns);
+        EXPECT_DOUBLE_EQ(j["results"][i]["control_gain"].get<double>(), 1 - row.control_ns / row.yardstick_ns);
+    }
+    EXPECT_EQ(r.rows[0].yardstick, "grid:res=hetero");
+    EXPECT_NE(design_table(r).find("control: grid:res=hetero"), std::string::npos);
 }
 
 TEST(BvhDesign, BoxesMetFourAtATimeAsBoxEntryFindsThem) {

@@ -67,6 +67,9 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
         for (const Family& k : kFamilies)
             if (fam == k.family) f = &k;
         EvalOptions eo;
+        // The control first, where the designed hierarchy would be: the first build is timed a
+        // little slower than the same one built later.
+        if (opt.control) eo.hierarchies.push_back(parse_hierarchy_list(f->yardstick, scene.size()).front());
         eo.hierarchies.push_back({f->designed, design_set(opt, scene)});
         // The BVH's occlusion order too (the model's replay takes the children front to back, so
         // its prediction for occlusion rays is then approximate).
@@ -87,8 +90,9 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
         res.distribution = r.distribution;
         res.sample = r.sample_rays;
         res.test_rays = r.test_rays;
-        const EvalRow& d = r.rows[0];
-        const EvalRow& y = r.rows[1];
+        const std::size_t at = opt.control ? 1 : 0;
+        const EvalRow& d = r.rows[at];
+        const EvalRow& y = r.rows[at + 1];
         DesignRow row;
         row.family = f->family;
         row.designed = d.name;
@@ -103,7 +107,8 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
         row.yardstick_measured = y.measured_scalar;
         row.designed_ns = d.ns_per_ray;
         row.yardstick_ns = y.ns_per_ray;
-        row.embree_ns = r.rows[2].ns_per_ray;
+        row.embree_ns = r.rows[at + 2].ns_per_ray;
+        if (opt.control) row.control_ns = r.rows[0].ns_per_ray;
         row.gain = row.yardstick_ns > 0 ? 1 - row.designed_ns / row.yardstick_ns : 0;
         res.rows.push_back(row);
     }
@@ -130,6 +135,10 @@ nlohmann::json to_json(const DesignResult& r) {
                         {"measured", {{"designed", x.designed_measured}, {"yardstick", x.yardstick_measured}}},
                         {"ns_per_ray", {{"designed", x.designed_ns}, {"yardstick", x.yardstick_ns}, {"embree", x.embree_ns}}},
                         {"gain", x.gain}});
+        if (x.control_ns > 0) {
+            rows.back()["ns_per_ray"]["control"] = x.control_ns;
+            rows.back()["control_gain"] = x.yardstick_ns > 0 ? 1 - x.control_ns / x.yardstick_ns : 0;
+        }
     }
     return {{"scene", r.scene},     {"distribution", r.distribution}, {"sample", r.sample},
             {"test_rays", r.test_rays}, {"units", r.calibrated ? "ns" : "operations"}, {"designed_for", r.designed_for},
@@ -155,9 +164,14 @@ std::string design_table(const DesignResult& r) {
                          x.designed_predicted, x.designed_measured, x.designed_ns, 100 * x.gain);
         s += fmt::format("{:<7} {:<26} {:>9.3f} {:>11.2f} {:>11.2f} {:>10.1f}\n", "", x.yardstick, x.yardstick_build,
                          x.yardstick_predicted, x.yardstick_measured, x.yardstick_ns);
+        if (x.control_ns > 0)
+            s += fmt::format("{:<7} {:<26} {:>9} {:>11} {:>11} {:>10.1f} {:>+6.1f}%\n", "", "control: " + x.yardstick, "", "",
+                             "", x.control_ns, 100 * (1 - x.control_ns / x.yardstick_ns));
     }
     if (!r.rows.empty()) s += fmt::format("{:<7} {:<26} {:>9} {:>11} {:>11} {:>10.1f}\n", "", "embree", "", "", "", r.rows.back().embree_ns);
     s += "\ngain: 1 - designed / yardstick measured single-thread ns per ray (0.2: 20% fewer ns)\n";
+    if (!r.rows.empty() && r.rows.front().control_ns > 0)
+        s += "control: a second copy of the yardstick, built and timed first; its gain is this run's noise\n";
     return s;
 }
 
