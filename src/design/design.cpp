@@ -115,6 +115,11 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
     return res;
 }
 
+namespace {
+// 1 - control ns / yardstick ns: how far apart the run timed two copies of the yardstick.
+double control_gain(const DesignRow& x) { return x.yardstick_ns > 0 ? 1 - x.control_ns / x.yardstick_ns : 0; }
+}  // namespace
+
 nlohmann::json to_json(const DesignResult& r) {
     nlohmann::json rows = nlohmann::json::array();
     for (const DesignRow& x : r.rows) {
@@ -137,7 +142,7 @@ nlohmann::json to_json(const DesignResult& r) {
                         {"gain", x.gain}});
         if (x.control_ns > 0) {
             rows.back()["ns_per_ray"]["control"] = x.control_ns;
-            rows.back()["control_gain"] = x.yardstick_ns > 0 ? 1 - x.control_ns / x.yardstick_ns : 0;
+            rows.back()["control_gain"] = control_gain(x);
         }
     }
     return {{"scene", r.scene},     {"distribution", r.distribution}, {"sample", r.sample},
@@ -166,7 +171,7 @@ std::string design_table(const DesignResult& r) {
                          x.yardstick_predicted, x.yardstick_measured, x.yardstick_ns);
         if (x.control_ns > 0)
             s += fmt::format("{:<7} {:<26} {:>9} {:>11} {:>11} {:>10.1f} {:>+6.1f}%\n", "", "control: " + x.yardstick, "", "",
-                             "", x.control_ns, 100 * (1 - x.control_ns / x.yardstick_ns));
+                             "", x.control_ns, 100 * control_gain(x));
     }
     if (!r.rows.empty()) s += fmt::format("{:<7} {:<26} {:>9} {:>11} {:>11} {:>10.1f}\n", "", "embree", "", "", "", r.rows.back().embree_ns);
     s += "\ngain: 1 - designed / yardstick measured single-thread ns per ray (0.2: 20% fewer ns)\n";

@@ -218,8 +218,9 @@ private:
                 bool ends = done() || beyond(far);
                 // A kd-tree's traversal widens the near side's end by a relative 4e-7 against
                 // rounding (kd::KdTree), so a hit that far past the plane (a face lying in it)
-                // ends the search before the far side, unless its cull_bound lies beyond. Not for a ray in the plane: both sides
-                // then cover the same stretch, and the traversal searches both.
+                // ends the search before the far side, unless its cull_bound lies beyond. Not for
+                // a ray in the plane: both sides then cover the same stretch, and the traversal
+                // searches both.
                 if (!ends && cull_ && t_.family == ModelFamily::Kd && m.axis >= 0 && m.axis < 3 &&
                     std::fabs(ri_.inv[m.axis]) < kInf) {
                     // The traversal decides at the last leaf it searched, whose segment kd-median's

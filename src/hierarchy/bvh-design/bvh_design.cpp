@@ -89,8 +89,9 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
         const double w = o.trust >= kNoTrust ? 0 : m / (m + o.trust);
         binned_cuts(ids, begin, end, info, cb, o.bins, w == 0 ? 1 : static_cast<std::size_t>(o.candidates), scratch,
                     cuts);
-        // Without sample weight the SAH's own bins alone, so that the design falls back to its tree exactly.
-        if (w > 0 && o.sweep > 0) swept_cuts(*orders, begin, end, info, static_cast<std::size_t>(o.sweep), scratch, cuts);
+        // The sweep's too where the sample weighs them; without sample weight the SAH's bins alone,
+        // so that the design falls back to its tree exactly.
+        if (w > 0 && orders) swept_cuts(*orders, begin, end, info, static_cast<std::size_t>(o.sweep), scratch, cuts);
         // Expected cost below this node, per ray reaching it: a leaf tests every primitive; a split
         // tests both child boxes and each child's primitives as often as the child is entered.
         double best = kInf;
@@ -132,15 +133,11 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
         }
         const double leaf = w == 0 ? static_cast<double>(static_cast<float>(prim_cost) * n) : prim_cost * n;
         if (static_cast<int>(n) <= o.max_prims && leaf <= best) return begin;
-        auto by_axis0 = [&](std::uint32_t a, std::uint32_t b) {
-            const float ca = info.centroids[a][0], cb0 = info.centroids[b][0];
-            return ca < cb0 || (ca == cb0 && a < b);
-        };
         std::uint32_t mid;
         if (chosen < 0) {
             // All centroids coincide: halve the list.
             mid = begin + n / 2;
-            std::nth_element(ids.begin() + begin, ids.begin() + mid, ids.begin() + end, by_axis0);
+            std::nth_element(ids.begin() + begin, ids.begin() + mid, ids.begin() + end, by_centroid(info, 0));
             best_left = best_right = rays;
         } else if (cuts[chosen].swept) {
             mid = begin + static_cast<std::uint32_t>(cuts[chosen].at);

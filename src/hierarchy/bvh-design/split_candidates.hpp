@@ -135,8 +135,9 @@ inline void swept_cuts(const AxisOrders& orders, std::uint32_t begin, std::uint3
 
 // The `keep` cheapest of every bin boundary on every axis by surface-area cost, cheapest first
 // (ties in the order of generation: axis, then bin), into `cuts`.
-inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end, const PrimInfo& info,
-                 const Box3& cb, int nbins, std::size_t keep, CutScratch& sc, std::vector<Cut>& cuts) {
+inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
+                        const PrimInfo& info, const Box3& cb, int nbins, std::size_t keep, CutScratch& sc,
+                        std::vector<Cut>& cuts) {
     sc.all.clear();
     sc.bins.assign(3 * nbins, CutScratch::Bin{});
     sc.suffix.resize(nbins + 1);
