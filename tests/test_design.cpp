@@ -388,7 +388,8 @@ TEST(Design, ControlTimesASecondCopyOfTheYardstick) {
 
 TEST(BvhDesign, BoxesMetFourAtATimeAsBoxEntryFindsThem) {
     // Random boxes and segments, and the hard cases: zero direction components, origins in a
-    // box's face plane, flat boxes, a box touching the segment's end.
+    // box's face plane, flat boxes, a box touching the segment's end, segments through the
+    // origin (where the padding boxes of the last four lie). Counted (count_met) as listed.
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(-2, 2);
     std::vector<Box3> boxes;
@@ -402,6 +403,8 @@ TEST(BvhDesign, BoxesMetFourAtATimeAsBoxEntryFindsThem) {
     boxes.push_back(Box3{{0, 0, 0}, {1, 1, 1}});
     bvh::BoxColumns columns;
     columns.assign(boxes);
+    ASSERT_EQ(columns.padded(), 16u);
+    std::vector<std::uint32_t> counts(columns.padded()), want_counts(columns.padded());
     std::size_t met_total = 0, tested = 0;
     for (int r = 0; r < 4000; ++r) {
         Ray ray{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, 0, r % 3 ? kInf : std::fabs(u(rng))};
@@ -409,14 +412,18 @@ TEST(BvhDesign, BoxesMetFourAtATimeAsBoxEntryFindsThem) {
         if (r % 11 == 0) ray.d = Vec3{0, 0, r % 2 ? 1.0f : -1.0f};
         if (r % 13 == 0) ray.o.x = 1;  // in a face plane of the unit box
         if (r % 17 == 0) ray.o = Vec3{0.5f, 0.5f, -1}, ray.d = Vec3{0, 0, 1}, ray.tmax = 1;  // ends at its face
+        if (r % 19 == 0) ray.o = Vec3{0, 0, -1}, ray.d = Vec3{0, 0, 1}, ray.tmax = kInf;  // through the origin
         const RayInv ri(ray);
         std::vector<char> want(boxes.size()), got(boxes.size());
         for (std::size_t j = 0; j < boxes.size(); ++j) want[j] = box_entry(boxes[j], ri, ray.tmin, ray.tmax) != kInf;
         columns.each_met(ri, ray.tmin, ray.tmax, [&](std::size_t j) { got[j] = 1; });
         ASSERT_EQ(got, want) << "ray " << r;
+        columns.count_met(ri, ray.tmin, ray.tmax, counts.data());
+        for (std::size_t j = 0; j < boxes.size(); ++j) want_counts[j] += want[j];
         for (char w : want) met_total += w;
         tested += boxes.size();
     }
+    EXPECT_EQ(counts, want_counts);
     // Both answers are common.
     EXPECT_GT(met_total, tested / 50);
     EXPECT_LT(met_total, tested * 9 / 10);

@@ -61,10 +61,10 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
             if (meets(r, s.bounds())) all.push_back(r);
         reaching[0] = std::move(all);
     }
-    // Reused from node to node: the candidates' boxes and the segments meeting each.
+    // Reused from node to node: the candidates' boxes and how many segments meet each.
     std::vector<Box3> boxes;
     BoxColumns columns;
-    std::vector<std::vector<std::uint32_t>> met;
+    std::vector<std::uint32_t> met;
     CutScratch scratch;
     std::vector<Cut> cuts;
     // The sweep's centroid orders, kept only where a sample weighs the cuts.
@@ -96,43 +96,46 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
         // tests both child boxes and each child's primitives as often as the child is entered.
         double best = kInf;
         int chosen = -1;
-        std::vector<std::uint32_t> best_left, best_right;
         const int k = w == 0 ? std::min<int>(1, static_cast<int>(cuts.size())) : static_cast<int>(cuts.size());
-        // The segments meeting each candidate's left and right box (met[2c], met[2c + 1]), as
-        // meets() finds them, all boxes of a ray at once.
+        // How many segments meet each candidate's left and right box (met[2c], met[2c + 1]), as
+        // meets() finds them, all boxes of a ray at once. Only the chosen cut's segments are
+        // listed, below: listing every candidate's took a fifth of the design time.
         if (w > 0) {
             boxes.clear();
             for (int c = 0; c < k; ++c) boxes.insert(boxes.end(), {cuts[c].left, cuts[c].right});
             columns.assign(boxes);
-            met.resize(std::max(met.size(), boxes.size()));
-            for (std::size_t j = 0; j < boxes.size(); ++j) met[j].clear();
+            met.assign(columns.padded(), 0);
             for (std::uint32_t r : rays) {
                 const Ray& ray = smp.rays.rays[r];
-                columns.each_met(inv[r], ray.tmin, std::min(ray.tmax, smp.t_end[r]),
-                                 [&](std::size_t j) { met[j].push_back(r); });
+                columns.count_met(inv[r], ray.tmin, std::min(ray.tmax, smp.t_end[r]), met.data());
             }
         }
         for (int c = 0; c < k; ++c) {
             const Cut& cut = cuts[c];
             double pl = area > 0 ? cut.left.area() / area : 1, pr = area > 0 ? cut.right.area() / area : 1;
-            std::vector<std::uint32_t> lr, rr;
             if (w > 0) {
-                lr = std::move(met[2 * c]);
-                rr = std::move(met[2 * c + 1]);
-                pl = w * (lr.size() / m) + (1 - w) * pl;
-                pr = w * (rr.size() / m) + (1 - w) * pr;
+                pl = w * (met[2 * c] / m) + (1 - w) * pl;
+                pr = w * (met[2 * c + 1] / m) + (1 - w) * pr;
             }
             const double cost =
                 w == 0 ? static_cast<double>(static_cast<float>(trav_cost) +
                                              static_cast<float>(prim_cost) * (area > 0 ? cut.sah / static_cast<float>(area) : n))
                        : trav_cost + prim_cost * (pl * cut.n_left + pr * cut.n_right);
-            if (cost < best) {
-                best = cost, chosen = c;
-                best_left = std::move(lr), best_right = std::move(rr);
-            }
+            if (cost < best) best = cost, chosen = c;
         }
         const double leaf = w == 0 ? static_cast<double>(static_cast<float>(prim_cost) * n) : prim_cost * n;
         if (static_cast<int>(n) <= o.max_prims && leaf <= best) return begin;
+        // The segments reaching each child.
+        std::vector<std::uint32_t> best_left, best_right;
+        if (w > 0 && chosen >= 0) {
+            const Box3 pair[2] = {cuts[chosen].left, cuts[chosen].right};
+            columns.assign(pair);
+            for (std::uint32_t r : rays) {
+                const Ray& ray = smp.rays.rays[r];
+                columns.each_met(inv[r], ray.tmin, std::min(ray.tmax, smp.t_end[r]),
+                                 [&](std::size_t j) { (j == 0 ? best_left : best_right).push_back(r); });
+            }
+        }
         std::uint32_t mid;
         if (chosen < 0) {
             // All centroids coincide: halve the list.
@@ -151,7 +154,6 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
                 return b < cut.at;
             });
             mid = static_cast<std::uint32_t>(it - ids.begin());
-            if (w == 0) best_left = best_right = {};
         }
         if (orders) orders->split(ids, begin, mid, end);
         reaching[begin] = std::move(best_left);
