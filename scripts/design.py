@@ -204,18 +204,20 @@ def main():
              f"Machine: {cpu_name()}, {os.cpu_count()} hardware threads, shared with other jobs while this ran "
              f"(absolute ns are noisy; designed, yardstick and Embree ran back to back on the same rays). "
              f"Date: {stamp}.", "",
-             "Where a structure's data land in memory moves its time as well: the same bvh-sah tree, traced by the "
-             "same code, took 74.7 to 78.1 ns per ray on sombrero's camera rays (128x128) depending only on the size "
-             "of an allocation made before the scene was read (measured 2026-12-05), and the first hierarchy an "
-             "evaluation builds was timed 1-2% slower than the same one built after it. A gain within a few percent "
-             "either way on a small scene is within that.", "",
+             "The structures are timed in rounds of one pass each, every round in a new order. Until 2026-12-05 "
+             "every round had the same order, turned by one: each structure then always followed the same one, "
+             "which left the caches and predictors its own way, and the structure after Embree was timed up to "
+             "6% apart from an identical copy timed elsewhere, the same way in every run (the A/A column of "
+             "earlier runs: -5.8% to +2.9%). Where a process's data land in memory still moves a time: the same bvh-sah tree, "
+             "traced by the same code, took 74.7 to 78.1 ns per ray on sombrero's camera rays (128x128) in "
+             "separate processes, depending only on the size of an allocation made before the scene was read.", "",
              "Each designed hierarchy draws its own sample of the distribution (the sample size below) and "
              "is measured on every other ray of the distribution (test rays). `predicted`: the model's "
              "operations per ray on the design sample (segments estimator); `measured`: counted operations "
              "per ray on the test rays (unit costs); `ns`: measured single-thread ns per ray on the test "
              "rays; `gain`: 1 - designed ns / yardstick ns; `build`: seconds, the designed one's including "
              "drawing its sample (the design time); `A/A`: 1 - control ns / yardstick ns, the control being a "
-             "second copy of the yardstick built and timed first, where the designed one is otherwise (`rtcost "
+             "second copy of the yardstick built first, where the designed one is otherwise (`rtcost "
              "design --control`): this run's noise on that row. The designs minimise "
              + (f"the ns per operation of `{a.costs}`" if a.costs else
                 "each family's default costs: typical ns per operation (rtcost's built-in `UnitCosts::typical`, "

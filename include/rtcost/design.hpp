@@ -65,8 +65,8 @@ struct DesignRow {
     double designed_ns = 0, yardstick_ns = 0;                  ///< single-thread ns per ray
     double embree_ns = 0;      ///< Embree's, on the same rays in the same run
     double gain = 0;           ///< 1 - designed_ns / yardstick_ns (0.2: 20% fewer ns per ray)
-    /// With DesignOptions::control: a second copy of the yardstick, built and timed first (where
-    /// the designed one is otherwise), its ns per ray; 0 otherwise.
+    /// With DesignOptions::control: a second copy of the yardstick, built first (where the
+    /// designed one is otherwise), its ns per ray; 0 otherwise.
     double control_ns = 0;
 };
 

@@ -67,8 +67,8 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
         for (const Family& k : kFamilies)
             if (fam == k.family) f = &k;
         EvalOptions eo;
-        // The control first, where the designed hierarchy would be: the first build is timed a
-        // little slower than the same one built later.
+        // The control first, where the designed hierarchy would be: built where the first
+        // structure's data land in memory.
         if (opt.control) eo.hierarchies.push_back(parse_hierarchy_list(f->yardstick, scene.size()).front());
         eo.hierarchies.push_back({f->designed, design_set(opt, scene)});
         // The BVH's occlusion order too (the model's replay takes the children front to back, so
@@ -176,7 +176,7 @@ std::string design_table(const DesignResult& r) {
     if (!r.rows.empty()) s += fmt::format("{:<7} {:<26} {:>9} {:>11} {:>11} {:>10.1f}\n", "", "embree", "", "", "", r.rows.back().embree_ns);
     s += "\ngain: 1 - designed / yardstick measured single-thread ns per ray (0.2: 20% fewer ns)\n";
     if (!r.rows.empty() && r.rows.front().control_ns > 0)
-        s += "control: a second copy of the yardstick, built and timed first; its gain is this run's noise\n";
+        s += "control: a second copy of the yardstick, built first; its gain is this run's noise\n";
     return s;
 }
 
