@@ -137,8 +137,8 @@ Subcommand setup_eval(CLI::App& parent, Common& common) {
                      "timed passes over the test rays (default: as many as take 0.2 s); the median is reported")
         ->check(CLI::Range(0, 10000));
     eval->add_flag("--interleave", a->interleave,
-                   "time the hierarchies in alternating passes once all are built (all kept in memory), so that "
-                   "the machine's changing load weighs on each alike");
+                   "time the hierarchies in rounds of one pass each, every round in a new order, once all are "
+                   "built (all kept in memory), so that the machine's changing load weighs on each alike");
     eval->add_option("--timing-threads", a->timing_threads, "threads of the timed passes (ns/ray is CPU time per ray)")
         ->check(CLI::Range(1, 1024))
         ->capture_default_str();

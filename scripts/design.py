@@ -128,7 +128,7 @@ def targets(rows, raw_sweeps):
                    f"({'met' if worst_ns >= -0.03 else 'not met'} in ns, {'met' if worst_ops >= -0.03 else 'not met'} in operations).")
         if controls:
             slower = sum(1 for x in controls if x < -0.03)
-            out.append(f"- the A/A control on the same {len(controls)} bvh rows (a second copy of bvh-sah against bvh-sah): "
+            out.append(f"- the A/A control on the same {len(controls)} bvh rows (bvh-sah in a second evaluation against the first): "
                        f"from {100 * min(controls):+.1f}% to {100 * max(controls):+.1f}%, more than 3% slower on {slower}; "
                        f"a gain of a few percent either way is within this run's noise.")
     grid = [(sc, gain(r, "ns_per_ray"), gain(r, "measured")) for sc, d, doc, r in rows
@@ -204,21 +204,21 @@ def main():
              f"Machine: {cpu_name()}, {os.cpu_count()} hardware threads, shared with other jobs while this ran "
              f"(absolute ns are noisy; designed, yardstick and Embree ran back to back on the same rays). "
              f"Date: {stamp}.", "",
-             "The structures are timed in rounds of one pass each, every round in a new order. Until 2026-12-05 "
-             "every round had the same order, turned by one: each structure then always followed the same one, "
-             "which left the caches and predictors its own way, and the structure after Embree was timed up to "
-             "6% apart from an identical copy timed elsewhere, the same way in every run (the A/A column of "
-             "earlier runs: -5.8% to +2.9%). Where a process's data land in memory still moves a time: the same bvh-sah tree, "
-             "traced by the same code, took 74.7 to 78.1 ns per ray on sombrero's camera rays (128x128) in "
-             "separate processes, depending only on the size of an allocation made before the scene was read.", "",
+             "The designed structure, its yardstick and Embree are timed in rounds of one pass each, every round "
+             "in a new order. Timed passes repeat the same rays, and the branch predictor learns them: a "
+             "structure timed alone, or beside an identical twin, runs faster than beside a different structure "
+             "traversed by the same code (bvh-sah on tree's diffuse rays: 59 ns per ray alone or beside its twin, "
+             "88 to 107 ns beside another BVH; 78 against 80 ns on its 78,000 spd rays). Runs of this table "
+             "before 2026-12-05 timed their A/A control beside the yardstick, which sped the yardstick up, and "
+             "had every round in one order turned by one; both biased their small rows' gains by up to 6%.", "",
              "Each designed hierarchy draws its own sample of the distribution (the sample size below) and "
              "is measured on every other ray of the distribution (test rays). `predicted`: the model's "
              "operations per ray on the design sample (segments estimator); `measured`: counted operations "
              "per ray on the test rays (unit costs); `ns`: measured single-thread ns per ray on the test "
              "rays; `gain`: 1 - designed ns / yardstick ns; `build`: seconds, the designed one's including "
-             "drawing its sample (the design time); `A/A`: 1 - control ns / yardstick ns, the control being a "
-             "second copy of the yardstick built first, where the designed one is otherwise (`rtcost "
-             "design --control`): this run's noise on that row. The designs minimise "
+             "drawing its sample (the design time); `A/A`: 1 - control ns / yardstick ns, the control being the "
+             "yardstick's time in a second evaluation of the three structures, built again with the yardstick "
+             "first (`rtcost design --control`): this run's noise on that row. The designs minimise "
              + (f"the ns per operation of `{a.costs}`" if a.costs else
                 "each family's default costs: typical ns per operation (rtcost's built-in `UnitCosts::typical`, "
                 "the time model fitted on the twelve scenes of docs/time-model.md, with its step, cache and "

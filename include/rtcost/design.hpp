@@ -65,8 +65,8 @@ struct DesignRow {
     double designed_ns = 0, yardstick_ns = 0;                  ///< single-thread ns per ray
     double embree_ns = 0;      ///< Embree's, on the same rays in the same run
     double gain = 0;           ///< 1 - designed_ns / yardstick_ns (0.2: 20% fewer ns per ray)
-    /// With DesignOptions::control: a second copy of the yardstick, built first (where the
-    /// designed one is otherwise), its ns per ray; 0 otherwise.
+    /// With DesignOptions::control: the yardstick's ns per ray in a second evaluation of the
+    /// designed one, the yardstick and Embree (built again, the yardstick first); 0 otherwise.
     double control_ns = 0;
 };
 
@@ -79,9 +79,9 @@ struct DesignOptions {
     /// or "ops" (operations), "typical", or empty: each family's default (design_param_specs), operations
     /// reported.
     std::string costs_file;
-    /// Also build and time a second copy of each yardstick (an A/A control): how far apart this run
-    /// times two copies of one structure, which where a structure's data land in memory and the
-    /// order of the builds move by a few percent.
+    /// Also build and evaluate each family's three structures a second time, the yardstick first
+    /// (an A/A control): how far apart two evaluations time the yardstick, which where a
+    /// structure's data land in memory moves by a few percent. Twice the time.
     bool control = false;
     std::function<void(const std::string&)> on_step;
 };

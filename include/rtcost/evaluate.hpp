@@ -71,10 +71,13 @@ struct EvalOptions {
     /// `min_seconds`; the median is reported with the spread.
     int repeat = 0;
     double min_seconds = 0.2;
-    /// Time the hierarchies in rounds, one pass of each per round, after all are built and
-    /// counted (all are kept in memory until then), instead of one after the other: a change in
-    /// the machine's load or clock during the run then weighs on every hierarchy alike, so
-    /// their ratio (a designed structure's gain over its yardstick) is not the load's.
+    /// Time the hierarchies in rounds, one pass of each per round in a new (seeded) order, after
+    /// all are built and counted (all are kept in memory until then), instead of one after the
+    /// other: a change in the machine's load or clock during the run then weighs on every
+    /// hierarchy alike, so their ratio (a designed structure's gain over its yardstick) is not
+    /// the load's. Passes repeat the same rays, which the branch predictor learns: on a few
+    /// thousand rays a structure is timed faster alone, or beside an identical twin, than beside
+    /// another structure of the same traversal code; compare structures timed in one company.
     bool interleave_timing = false;
     /// Called as each step of each hierarchy starts ("build NAME", "counting NAME", "timing
     /// NAME", "model NAME"), with the progress of the trace passes (step, rays done, rays), and
