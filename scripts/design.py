@@ -220,9 +220,11 @@ def main():
              "yardstick's time in a second evaluation of the three structures, built again with the yardstick "
              "first (`rtcost design --control`): this run's noise on that row. The designs minimise "
              + (f"the ns per operation of `{a.costs}`" if a.costs else
-                "each family's default costs: typical ns per operation (rtcost's built-in `UnitCosts::typical`, "
+                "each family's default costs: for bvh a BVH's own ns per box test against each kind of primitive "
+                "test (`typical-bvh`, rtcost's built-in `UnitCosts::typical_bvh`, the margins between BVHs of one "
+                "scene that scripts/bvh-prices.py fits), for kd typical ns per operation (`UnitCosts::typical`, "
                 "the time model fitted on the twelve scenes of docs/time-model.md, with its step, cache and "
-                "polygon-edge terms) for bvh and kd, operation counts for grid, octree and bsp (`ops`: a polygon "
+                "polygon-edge terms), operation counts for grid, octree and bsp (`ops`: a polygon "
                 "edge walked counts as the share of a test the time model gives it, about a quarter)") + ".", "",
              "| scene | rays | family | sample | test rays | build s (design / yardstick) | predicted ops | measured ops | ns per ray | Embree ns | gain | A/A |",
              "|---|---|---|---|---|---|---|---|---|---|---|---|"]

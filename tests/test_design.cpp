@@ -140,13 +140,25 @@ TEST(Design, DesignsMinimiseTypicalTimeUnlessToldOtherwise) {
     EXPECT_LT(with_edges.costs.polygon_edge, 0.5);
     // Each family's default: time where the fitted costs describe its traversal, else counts.
     for (const auto& [name, want] : std::vector<std::pair<std::string, std::string>>{
-             {"bvh-design", "typical"}, {"kd-design", "typical"}, {"grid-design", "ops"},
+             {"bvh-design", "typical-bvh"}, {"kd-design", "typical"}, {"grid-design", "ops"},
              {"octree-design", "ops"}, {"bsp-design", "ops"}}) {
         std::string got;
         for (const ParamSpec& p : find_hierarchy(name)->params)
             if (p.name == "costs") got = p.default_value;
         EXPECT_EQ(got, want) << name;
     }
+    // A BVH's own margins: a box test carries its step, and a triangle or polygon test costs more
+    // than the two box tests of a node visit, a sphere's less.
+    std::vector<std::string> bvh = base;
+    bvh.push_back("costs=typical-bvh");
+    const UnitCosts b = draw_design_input(s, Params(design_param_specs(), bvh)).costs;
+    EXPECT_TRUE(b.calibrated);
+    EXPECT_EQ(b.box, UnitCosts::typical_bvh().box);
+    EXPECT_EQ(b.step, 0.0);
+    EXPECT_GT(b.prim[static_cast<int>(PrimKind::Polygon)], 2 * b.box);
+    EXPECT_GT(b.prim[static_cast<int>(PrimKind::Triangle)], 2 * b.box);
+    EXPECT_LT(b.prim[static_cast<int>(PrimKind::Sphere)], 2 * b.box);
+    EXPECT_TRUE(UnitCosts::built_in("typical-bvh"));
     std::vector<std::string> missing = base;
     missing.push_back("costs=/nonexistent/costs.json");
     EXPECT_THROW(draw_design_input(s, Params(design_param_specs(), missing)), InputError);

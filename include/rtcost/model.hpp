@@ -72,12 +72,21 @@ struct UnitCosts {
     /// tests that cost several times more (docs/design.md). Fitted by `rtcost calibrate` on one
     /// machine (unit_costs.cpp says which); their ratios, not their nanoseconds, steer a design.
     static UnitCosts typical();
+    /// A BVH's margins, built in: ns per box test (its step's share included) against ns per
+    /// primitive test of each kind, as they move between BVHs of one scene and distribution
+    /// (scripts/bvh-prices.py; unit_costs.cpp says where). What bvh-design minimises by default:
+    /// typical() takes its step price from every family's traversal and its primitive prices
+    /// across scenes, and priced a BVH's polygon test at half a node visit where the margin
+    /// between BVHs is more than one.
+    static UnitCosts typical_bvh();
     /// "unit" (the paper's operation counts), "ops" (operation counts with each polygon edge a
-    /// crossing test walks at the share of the test typical() gives it), "typical" (typical()) or a
-    /// costs file's path (`./ops` names a file called ops).
+    /// crossing test walks at the share of the test typical() gives it), "typical" (typical()),
+    /// "typical-bvh" (typical_bvh()) or a costs file's path (`./ops` names a file called ops).
     static UnitCosts named(const std::string& name);
     /// Whether named() takes `name` as one of its built-in tables rather than a costs file.
-    static bool built_in(const std::string& name) { return name == "unit" || name == "ops" || name == "typical"; }
+    static bool built_in(const std::string& name) {
+        return name == "unit" || name == "ops" || name == "typical" || name == "typical-bvh";
+    }
 };
 
 /// One calibration run: the measured operations per ray and the measured single-thread

@@ -17,7 +17,8 @@ std::vector<ParamSpec> design_param_specs(const std::string& default_costs) {
             ParamSpec::integer("sample", "4096", 1, 1 << 20, "rays in the design sample (at most half the distribution)"),
             ParamSpec::integer("seed", "1", 0, 1LL << 62, "seed of the sample's draw (the distribution's own seed is 1)"),
             ParamSpec::text("costs", default_costs,
-                            "ns per operation the design minimises: typical (built in), unit (the paper's operation "
+                            "ns per operation the design minimises: typical (built in, every family's time model), "
+                            "typical-bvh (built in, a BVH's box test against its primitive tests), unit (the paper's operation "
                             "counts), ops (operation counts, a polygon's edges at the share of its test the built-in "
                             "time model gives them), or a costs file of rtcost calibrate (./ops: a file called ops)")};
 }

@@ -54,6 +54,22 @@ UnitCosts UnitCosts::typical() {
     return c;
 }
 
+UnitCosts UnitCosts::typical_bvh() {
+    // scripts/bvh-prices.py on the ten SPD scenes, 2CylinderEngine.glb and yxa_1.blend, camera,
+    // diffuse and spd rays at 128x128: bvh-sah with c_trav 0.5, 1, 2, 3 and 5, each scene and
+    // distribution in one `eval --interleave` on one core with its own fixed ns per ray, so that
+    // only the trees' differences fix the prices (180 runs, rms relative residual 1.5%; AMD EPYC,
+    // 2026-12-05; a second run gave the same prices within 3%, but triangles 10.85 and spheres 2.43). A box test carries its step (two per
+    // visit). No step or cache term: within a scene the trees' sizes hardly differ.
+    UnitCosts c = typical();
+    c.box = 4.81;
+    c.step = 0;
+    c.cache = 0;
+    c.prim = {11.69, 11.61, 2.83, 21.95};  // triangle, polygon, sphere, cone
+    c.polygon_edge = 1.40;
+    return c;
+}
+
 UnitCosts UnitCosts::named(const std::string& name) {
     if (name == "unit") return UnitCosts{};
     if (name == "ops") {
@@ -68,6 +84,7 @@ UnitCosts UnitCosts::named(const std::string& name) {
         return c;
     }
     if (name == "typical" || name.empty()) return typical();
+    if (name == "typical-bvh") return typical_bvh();
     return read(name);
 }
 

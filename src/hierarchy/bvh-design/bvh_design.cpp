@@ -167,7 +167,7 @@ const Registration reg{
     {"bvh-design",
      "binned BVH whose splits minimise the cost model with visit probabilities from a sample of the given rays",
      [] {
-         std::vector<ParamSpec> p = design_param_specs();
+         std::vector<ParamSpec> p = design_param_specs("typical-bvh");
          p.push_back(ParamSpec::integer("max_prims", "32", 1, 1 << 20, "largest leaf (bigger nodes are always split)"));
          p.push_back(ParamSpec::integer("max_depth", "64", 0, kMaxDepth, "deepest leaf"));
          p.push_back(ParamSpec::integer("bins", "16", 2, 256, "bins per axis"));
