@@ -48,7 +48,7 @@ Subcommand setup_design(CLI::App& parent, Common& common) {
         ->capture_default_str();
     cmd->add_option("--sample", a->opt.sample, "rays in the design sample")->capture_default_str();
     cmd->add_option("--seed", a->opt.seed, "seed of the sample's draw")->capture_default_str();
-    cmd->add_option("--costs", a->opt.costs_file, "what the designs minimise: a costs file of rtcost calibrate (its ns per operation; the table too), unit (operation counts), ops (operation counts, a polygon's edges at a share of its test) typical (built-in ns per operation) or typical-bvh (built-in, a BVH's box test against its primitive tests); default: each family's own (typical-bvh for bvh, typical for kd, ops for grid, octree and bsp)");
+    cmd->add_option("--costs", a->opt.costs_file, "what the designs minimise: a costs file of rtcost calibrate (its ns per operation; the table too), unit (operation counts), ops (operation counts, a polygon's edges at a share of its test), typical (built-in ns per operation) or typical-bvh (built-in, a BVH's box test against its primitive tests); default: each family's own (typical-bvh for bvh, typical for kd, ops for grid, octree and bsp)");
     cmd->add_flag("--control", a->opt.control,
                   "also build and evaluate each family's structures a second time, the yardstick first: how far apart "
                   "two evaluations time the yardstick (twice the time)");

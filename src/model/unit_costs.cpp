@@ -59,8 +59,9 @@ UnitCosts UnitCosts::typical_bvh() {
     // diffuse and spd rays at 128x128: bvh-sah with c_trav 0.5, 1, 2, 3 and 5, each scene and
     // distribution in one `eval --interleave` on one core with its own fixed ns per ray, so that
     // only the trees' differences fix the prices (180 runs, rms relative residual 1.5%; AMD EPYC,
-    // 2026-12-05; a second run gave the same prices within 3%, but triangles 10.85 and spheres 2.43). A box test carries its step (two per
-    // visit). No step or cache term: within a scene the trees' sizes hardly differ.
+    // 2026-12-05; a second run gave the same prices within 3%, but triangles 10.85 and spheres
+    // 2.43). A box test carries its step (two per visit). No step or cache term: within a scene
+    // the trees' sizes hardly differ.
     UnitCosts c = typical();
     c.box = 4.81;
     c.step = 0;
