@@ -6,8 +6,6 @@
 #include <iterator>
 #include <map>
 #include <memory>
-#include <numeric>
-#include <random>
 #include <unistd.h>
 
 #include "cli.hpp"
@@ -101,18 +99,9 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
             }
             timed.push_back(std::move(t));
         }
-        // Each round in a new order (seeded): a pass finds the caches and predictors as the
-        // previous pass left them, and one fixed order had each hierarchy always follow the
-        // same one (in eval, the one after embree was timed up to 6% apart from its identical copy).
-        if (!a.sequential) {
-            std::vector<std::size_t> order(timed.size());
-            std::iota(order.begin(), order.end(), std::size_t{0});
-            std::mt19937_64 order_rng(1);
-            for (int r = 0; r < a.repeat; ++r) {
-                std::shuffle(order.begin(), order.end(), order_rng);
-                for (std::size_t i : order) time_once(timed[i]);
-            }
-        }
+        if (!a.sequential)
+            for (int r = 0; r < a.repeat; ++r)
+                for (std::size_t i : timing_order(timed.size(), r)) time_once(timed[i]);
         for (Timed& t : timed) {
             if (t.h) t.s.structure = t.h->structure();
             t.s.ns_per_ray = rays.rays.empty() ? 0.0 : t.best * 1e9 / rays.rays.size();

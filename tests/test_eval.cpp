@@ -1,6 +1,11 @@
 // The evaluation as a user reads it: hierarchy lists with their own parameters, brute force and
 // Embree where they belong, the query of every ray kind, repeated timings and rankings by time,
-// camera and lights from the command line, and a default camera that sees the mesh.
+// camera and lights from the command line, a default camera that sees the mesh, and the order of
+// interleaved timing rounds.
+#include <algorithm>
+#include <array>
+#include <set>
+
 #include <fmt/format.h>
 
 #include "rtcost/evaluate.hpp"
@@ -160,6 +165,40 @@ TEST(RankCorrelation, SpearmansRhoOfKnownRankings) {
     EXPECT_DOUBLE_EQ(rank_correlation(a, reversed), -1.0);
     EXPECT_DOUBLE_EQ(rank_correlation(a, swapped), 0.8);  // one adjacent swap: 1 - 6 * 2 / (4 * 15)
     EXPECT_DOUBLE_EQ(rank_correlation(std::vector<double>{1}, std::vector<double>{2}), 0.0);
+}
+
+TEST(TimingOrder, EachRoundAPermutationNewEachRoundTheSameEveryRun) {
+    constexpr std::size_t n = 5;
+    constexpr int rounds = 400;
+    std::array<int, n> first{};
+    std::array<std::array<int, n>, n> after{};  // after[a][b]: rounds in which b was timed right after a
+    std::set<std::vector<std::size_t>> seen;
+    for (int r = 0; r < rounds; ++r) {
+        const std::vector<std::size_t> order = timing_order(n, r);
+        ASSERT_EQ(order, timing_order(n, r));
+        std::vector<std::size_t> sorted = order;
+        std::sort(sorted.begin(), sorted.end());
+        ASSERT_EQ(sorted, (std::vector<std::size_t>{0, 1, 2, 3, 4}));
+        ++first[order[0]];
+        for (std::size_t i = 1; i < n; ++i) ++after[order[i - 1]][order[i]];
+        seen.insert(order);
+    }
+    EXPECT_GT(seen.size(), 80u);  // of the 120 orders
+    // Uniform: each structure first in about a fifth of the rounds, and each followed by each other
+    // one in about a fifth (expected 80 of 400, standard deviation 8).
+    for (std::size_t a = 0; a < n; ++a) {
+        EXPECT_GT(first[a], 50) << a;
+        EXPECT_LT(first[a], 110) << a;
+        for (std::size_t b = 0; b < n; ++b)
+            if (b != a) {
+                EXPECT_GT(after[a][b], 50) << a << " then " << b;
+                EXPECT_LT(after[a][b], 110) << a << " then " << b;
+            }
+    }
+    // The same on every standard library: mt19937_64's raw words, Fisher-Yates by hand.
+    EXPECT_EQ(timing_order(n, 0), (std::vector<std::size_t>{1, 4, 3, 2, 0}));
+    EXPECT_TRUE(timing_order(0, 3).empty());
+    EXPECT_EQ(timing_order(1, 3), std::vector<std::size_t>{0});
 }
 
 }  // namespace

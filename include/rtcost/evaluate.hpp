@@ -156,6 +156,12 @@ std::string eval_columns();
 std::string eval_row(const EvalRow& row);
 std::string eval_summary(const EvalResult& r, bool by_depth = false);
 
+/// The order in which round `round` (0, 1, ...) of interleaved timing passes over `n` timed
+/// structures: a permutation of 0..n-1, new each round and the same in every run and on every
+/// standard library. A pass finds the caches and branch predictors as the previous pass left
+/// them; one fixed order had each structure always follow the same one.
+std::vector<std::size_t> timing_order(std::size_t n, int round);
+
 /// Spearman's rank correlation of `x` and `y` (same length; ties ranked in order, 0 for fewer
 /// than two values): how alike a prediction ranks what was measured.
 double rank_correlation(std::span<const double> x, std::span<const double> y);

@@ -9,7 +9,6 @@
 #include <memory>
 #include <numeric>
 #include <optional>
-#include <random>
 #include <stdexcept>
 
 #include "rtcost/error.hpp"
@@ -19,6 +18,15 @@
 #include "util/rng.hpp"
 
 namespace rtcost {
+
+std::vector<std::size_t> timing_order(std::size_t n, int round) {
+    std::vector<std::size_t> order(n);
+    std::iota(order.begin(), order.end(), std::size_t{0});
+    // One stream per round, so that round r's order does not depend on how many came before.
+    Rng rng(mix64(static_cast<std::uint64_t>(round) + 1));
+    shuffle(order, rng);
+    return order;
+}
 
 namespace {
 
@@ -313,13 +321,10 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         // apart from an identical copy elsewhere, the same way in every run of one command.
         if (opt.on_step) opt.on_step("timing (interleaved)");
         std::vector<PassTimes> times(timed_later.size());
-        std::vector<std::size_t> order(timed_later.size());
-        std::iota(order.begin(), order.end(), std::size_t{0});
-        std::mt19937_64 order_rng(1);
-        for (bool more = true; more;) {
+        bool more = true;
+        for (int round = 0; more; ++round) {
             more = false;
-            std::shuffle(order.begin(), order.end(), order_rng);
-            for (std::size_t i : order) {
+            for (std::size_t i : timing_order(timed_later.size(), round)) {
                 if (!times[i].more(opt)) continue;
                 const Timed& t = timed_later[i];
                 times[i].add(trace_ray_set(*t.h, t.subset.rays.empty() ? test : t.subset, t.to, opt.occlusion));

@@ -6,6 +6,8 @@
 #include <cstdint>
 #include <numbers>
 #include <random>
+#include <utility>
+#include <vector>
 
 #include "rtcost/math.hpp"
 
@@ -35,6 +37,13 @@ struct Rng {
         return {static_cast<float>(r * std::cos(phi)), static_cast<float>(r * std::sin(phi)), static_cast<float>(z)};
     }
 };
+
+/// Fisher-Yates on the raw output: the same permutation on every standard library (std::shuffle's
+/// is not specified).
+template <class T>
+void shuffle(std::vector<T>& items, Rng& rng) {
+    for (std::size_t i = items.size(); i > 1; --i) std::swap(items[i - 1], items[rng.engine() % i]);
+}
 
 /// splitmix64 as a generator whose whole state is one word, so that every item (a pixel, a
 /// sample) gets its own stream from (seed, item) whatever thread computes it.

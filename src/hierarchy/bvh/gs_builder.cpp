@@ -198,9 +198,8 @@ BvhData build_gs(const Scene& s, const GsOptions& o) {
     std::vector<std::uint32_t> order(s.size());
     for (std::uint32_t i = 0; i < s.size(); ++i) order[i] = i;
     if (o.seed != 0) {
-        // Fisher-Yates on the raw output: the same order on every standard library.
         Rng rng(o.seed);
-        for (std::size_t i = order.size(); i > 1; --i) std::swap(order[i - 1], order[rng.engine() % i]);
+        shuffle(order, rng);
     }
     GsTree tree(info, o);
     for (std::uint32_t id : order) tree.insert(id);
