@@ -28,9 +28,9 @@ struct CutScratch {
         std::uint32_t n = 0;
     };
     std::vector<Bin> bins;
-    std::vector<Box3> suffix;
+    std::vector<float> suffix_area;
     std::vector<std::uint32_t> suffix_n;
-    std::vector<Cut> all;
+    std::vector<Cut> all;  // without boxes: a node's bins give 45 cuts, of which a few are kept
     std::vector<std::uint32_t> order;
     std::vector<float> right_area;
 };
@@ -140,7 +140,7 @@ inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t beg
                         std::vector<Cut>& cuts) {
     sc.all.clear();
     sc.bins.assign(3 * nbins, CutScratch::Bin{});
-    sc.suffix.resize(nbins + 1);
+    sc.suffix_area.resize(nbins + 1);
     sc.suffix_n.resize(nbins + 1);
     // One pass over the primitives fills the three axes' bins.
     float lo[3], scale[3];
@@ -162,12 +162,17 @@ inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t beg
     for (int axis = 0; axis < 3; ++axis) {
         if (!(cb.hi[axis] - lo[axis] > 0)) continue;
         const CutScratch::Bin* bins = sc.bins.data() + axis * nbins;
-        sc.suffix[nbins] = Box3{};
+        // The running box in a local (read back from the array it had just gone to, it waited on
+        // the store every bin), and only its area kept: boxes are made for the kept cuts alone.
+        Box3 suffix;
+        std::uint32_t suffix_n = 0;
+        sc.suffix_area[nbins] = suffix.area();
         sc.suffix_n[nbins] = 0;
         for (int b = nbins - 1; b >= 0; --b) {
-            sc.suffix[b] = sc.suffix[b + 1];
-            sc.suffix[b].extend(bins[b].box);
-            sc.suffix_n[b] = sc.suffix_n[b + 1] + bins[b].n;
+            suffix.extend(bins[b].box);
+            suffix_n += bins[b].n;
+            sc.suffix_area[b] = suffix.area();
+            sc.suffix_n[b] = suffix_n;
         }
         Box3 prefix;
         std::uint32_t n = 0;
@@ -175,12 +180,20 @@ inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t beg
             prefix.extend(bins[b].box);
             n += bins[b].n;
             if (n == 0 || sc.suffix_n[b + 1] == 0) continue;
-            sc.all.push_back({axis, b + 1, false, prefix.area() * n + sc.suffix[b + 1].area() * sc.suffix_n[b + 1], prefix,
-                              sc.suffix[b + 1], n, sc.suffix_n[b + 1]});
+            sc.all.push_back({axis, b + 1, false, prefix.area() * n + sc.suffix_area[b + 1] * sc.suffix_n[b + 1], Box3{},
+                              Box3{}, n, sc.suffix_n[b + 1]});
         }
     }
     cuts.clear();
     keep_cheapest(keep, sc, cuts);
+    for (Cut& cut : cuts) {
+        const CutScratch::Bin* bins = sc.bins.data() + cut.axis * nbins;
+        Box3 left, right;  // locals, as above
+        for (int b = 0; b < cut.at; ++b) left.extend(bins[b].box);
+        for (int b = cut.at; b < nbins; ++b) right.extend(bins[b].box);
+        cut.left = left;
+        cut.right = right;
+    }
 }
 
 }  // namespace rtcost::bvh
