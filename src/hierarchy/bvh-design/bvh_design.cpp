@@ -38,7 +38,16 @@ struct DesignOptions {
 };
 
 
-BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions& o) {
+/// The root's centroid orders of the sweep (AxisOrders), sorted once for a design's several builds.
+std::optional<AxisOrders> root_orders(const Scene& s, const DesignOptions& o) {
+    if (o.sweep <= 0 || o.trust >= kNoTrust) return std::nullopt;
+    std::vector<std::uint32_t> all(s.size());
+    for (std::uint32_t i = 0; i < s.size(); ++i) all[i] = i;
+    return AxisOrders(all, PrimInfo(s));
+}
+
+/// `root`: root_orders(s, o).
+BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions& o, const std::optional<AxisOrders>& root) {
     PrimInfo info(s);
     const RaySample& smp = in.sample;
     std::vector<RayInv> inv;
@@ -72,12 +81,7 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
     CutScratch scratch;
     std::vector<Cut> cuts;
     // The sweep's centroid orders, kept only where a sample weighs the cuts.
-    std::optional<AxisOrders> orders;
-    if (o.sweep > 0 && o.trust < kNoTrust) {
-        std::vector<std::uint32_t> all(s.size());
-        for (std::uint32_t i = 0; i < s.size(); ++i) all[i] = i;
-        orders.emplace(all, info);
-    }
+    std::optional<AxisOrders> orders = root;
     BvhData data = build_topdown(s, info, [&](std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
                                       const Box3& box, int depth) -> std::uint32_t {
         std::vector<std::uint32_t> rays = std::move(reaching[begin]);
@@ -191,7 +195,8 @@ RaySample half_of(const RaySample& smp, std::size_t parity) {
 /// 8% more against bvh-sah and raised teapot's by 7%). Each count is designed on half the sample
 /// and priced on the other half; the cheapest there is kept. (Three more builds, each on a core
 /// of its own where there are cores.)
-int held_out_candidates(const Scene& s, const DesignInput& in, const DesignOptions& o) {
+int held_out_candidates(const Scene& s, const DesignInput& in, const DesignOptions& o,
+                        const std::optional<AxisOrders>& root) {
     static constexpr int kCounts[] = {8, 16, 32};
     DesignInput half;
     half.costs = in.costs;
@@ -202,7 +207,7 @@ int held_out_candidates(const Scene& s, const DesignInput& in, const DesignOptio
     tbb::parallel_for(std::size_t{0}, std::size(kCounts), [&](std::size_t i) {
         DesignOptions with = o;
         with.candidates = kCounts[i];
-        const Bvh h(s, "bvh-design", build_design(s, half, with), true);
+        const Bvh h(s, "bvh-design", build_design(s, half, with, root), true);
         cost[i] = replay.time(h);
     });
     std::size_t best = 0;  // a tie keeps the fewer
@@ -248,8 +253,9 @@ const Registration reg{
          o.candidates = p.is("candidates", "auto") ? 0 : static_cast<int>(p.integer("candidates"));
          o.trust = p.real("trust");
          const DesignInput in = draw_design_input(s, p);
-         if (o.candidates == 0) o.candidates = o.trust < kNoTrust ? held_out_candidates(s, in, o) : 8;
-         BvhData designed_tree = build_design(s, in, o);
+         const std::optional<AxisOrders> root = root_orders(s, o);
+         if (o.candidates == 0) o.candidates = o.trust < kNoTrust ? held_out_candidates(s, in, o, root) : 8;
+         BvhData designed_tree = build_design(s, in, o, root);
          // bvh-sah's tree where the model predicts it cheaper on the sample than the designed
          // splits (as design/cheaper.hpp does for the other families).
          SahOptions usual;
