@@ -62,50 +62,9 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         Scene scene = load(spec, common, a.rays.view);
         RaySet rays = make_rays(scene, a.rays);
         print_warnings(rays.warnings, common.quiet || common.json);
-        TraceOptions opt;
-        opt.threads = 1;  // unit costs are single-thread figures
-        struct Timed {
-            std::unique_ptr<Hierarchy> h;
-            CalibrationSample s;
-            double best = kInf;
-        };
-        std::vector<Timed> timed;
-        // CPU time, the fastest of several passes: the least disturbed by the machine. Counted
-        // first, so that a lazily built structure (rc5d) is complete when timed. Interleaved
-        // (every hierarchy once per round, all built first), a slow spell of the machine falls
-        // on every hierarchy of the scene alike instead of on one, whose rank among the others
-        // it would change; the rank is what the held-out check judges.
-        auto time_once = [&](Timed& t) {
-            t.best = std::min(t.best, trace_ray_set(*t.h, rays, opt).cpu_seconds);
-            progress.update(++passes);
-        };
-        for (const HierarchyRequest& req : names) {
-            auto h = build_hierarchy(scene, req.name, req.params);
-            if (!h->counted()) {  // Embree's operations are not counted
-                progress.update(passes += per_run);
-                continue;
-            }
-            Timed t{std::move(h), {}, kInf};
-            TraceOptions counting = opt;
-            counting.count = true;
-            const TraceResult counted = trace_ray_set(*t.h, rays, counting);
-            progress.update(++passes);
-            t.s.label = req.label() + " on " + scene.name;
-            t.s.ops = measured_cost(counted.counters);
-            if (a.sequential) {
-                for (int r = 0; r < a.repeat; ++r) time_once(t);
-                t.s.structure = t.h->structure();
-                t.h.reset();
-            }
-            timed.push_back(std::move(t));
-        }
-        if (!a.sequential)
-            for (int r = 0; r < a.repeat; ++r)
-                for (std::size_t i : timing_order(timed.size(), r)) time_once(timed[i]);
-        for (Timed& t : timed) {
-            if (t.h) t.s.structure = t.h->structure();
-            t.s.ns_per_ray = rays.rays.empty() ? 0.0 : t.best * 1e9 / rays.rays.size();
-            into.push_back(std::move(t.s));
+        for (CalibrationSample& s : measure_for_calibration(scene, rays, names, a.repeat, a.sequential,
+                                                            [&](std::size_t n) { progress.update(passes += n); })) {
+            into.push_back(std::move(s));
             if (scene_of) scene_of->push_back(scene.name);
         }
     };

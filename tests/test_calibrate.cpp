@@ -1,10 +1,14 @@
 // Fitting nanoseconds per operation kind to measured times (rtcost calibrate): synthetic runs
 // timed by known costs, exact or with a deterministic scatter, must give the costs back, or where
-// the runs cannot fix a price, a price near the others'.
+// the runs cannot fix a price, a price near the others'; and the runs themselves, measured on a
+// scene.
 #include <cmath>
 
 #include "rtcost/error.hpp"
+#include "rtcost/evaluate.hpp"
+#include "rtcost/io.hpp"
 #include "rtcost/model.hpp"
+#include "rtcost/trace.hpp"
 #include "test_support.hpp"
 
 namespace rtcost::test {
@@ -170,6 +174,42 @@ TEST(Calibrate, APriceNoisyRunsFixPoorlyStaysNearTheOtherKinds) {
         EXPECT_GT(cone, 10);
         EXPECT_LT(cone, 17);
         EXPECT_GT(c.rms_relative, 0.05);  // the scatter is there: the fit does not hide it
+    }
+}
+
+TEST(CalibrationRuns, EachCountedHierarchyCountedOnceAndTimedInRounds) {
+    // Embree counts nothing and is left out; the others are counted as a counted trace counts
+    // them, timed (ns per ray > 0), and the passes add up to hierarchies x (1 + repeat),
+    // interleaved or one after the other.
+    const Scene s = load_scene("builtin:balls:2");
+    RaySpec spec;
+    spec.name = "camera";
+    spec.size = "16x16";
+    const RaySet rays = make_rays(s, spec);
+    const std::vector<HierarchyRequest> hs = parse_hierarchy_list("bvh-sah,embree,grid:res=2x2x2", s.size());
+    for (bool sequential : {false, true}) {
+        std::size_t passes = 0;
+        const std::vector<CalibrationSample> runs =
+            measure_for_calibration(s, rays, hs, 3, sequential, [&](std::size_t n) { passes += n; });
+        EXPECT_EQ(passes, 3u * 4u);
+        ASSERT_EQ(runs.size(), 2u);
+        EXPECT_EQ(runs[0].label, "bvh-sah on " + s.name);
+        EXPECT_EQ(runs[1].label, "grid:res=2x2x2 on " + s.name);
+        for (std::size_t i = 0; i < runs.size(); ++i) {
+            auto h = build_hierarchy(s, hs[i == 0 ? 0 : 2].name, hs[i == 0 ? 0 : 2].params);
+            TraceOptions o;
+            o.count = true;
+            o.threads = 1;
+            const CostVector want = measured_cost(trace_ray_set(*h, rays, o).counters);
+            EXPECT_DOUBLE_EQ(runs[i].ops.box, want.box) << i;
+            EXPECT_DOUBLE_EQ(runs[i].ops.hop, want.hop) << i;
+            EXPECT_DOUBLE_EQ(runs[i].ops.prim[static_cast<int>(PrimKind::Sphere)],
+                             want.prim[static_cast<int>(PrimKind::Sphere)]) << i;
+            EXPECT_GT(runs[i].ns_per_ray, 0.0) << i;
+            EXPECT_GT(runs[i].structure.bytes, 0u) << i;
+        }
+        EXPECT_GT(runs[0].ops.box, 0.0);
+        EXPECT_GT(runs[1].ops.hop, 0.0);
     }
 }
 

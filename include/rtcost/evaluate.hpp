@@ -162,6 +162,20 @@ std::string eval_summary(const EvalResult& r, bool by_depth = false);
 /// them; one fixed order had each structure always follow the same one.
 std::vector<std::size_t> timing_order(std::size_t n, int round);
 
+/// What `rtcost calibrate` measures on one scene: each hierarchy of `hierarchies` built, counted on
+/// `rays` with one thread, and timed `repeat` times (CPU time, the fastest pass kept: the least
+/// disturbed by the machine), in rounds of one pass each in timing_order -- all built first, so
+/// that a slow spell of the machine falls on every hierarchy alike rather than on the one whose
+/// rank it would change -- or, `sequential`, right after its build and freed once timed (less
+/// memory). Counted before timed, so that a lazily built structure (rc5d) is whole when timed.
+/// Hierarchies that count nothing (embree) are left out. `on_passes(n)`: n more of the
+/// hierarchies x (1 + repeat) passes done (a left-out hierarchy's all at once). Labels are
+/// "LABEL on SCENE".
+std::vector<CalibrationSample> measure_for_calibration(const Scene& scene, const RaySet& rays,
+                                                       const std::vector<HierarchyRequest>& hierarchies, int repeat,
+                                                       bool sequential,
+                                                       const std::function<void(std::size_t n)>& on_passes = {});
+
 /// Spearman's rank correlation of `x` and `y` (same length; ties ranked in order, 0 for fewer
 /// than two values): how alike a prediction ranks what was measured.
 double rank_correlation(std::span<const double> x, std::span<const double> y);
