@@ -71,15 +71,7 @@ INSTANTIATE_TEST_SUITE_P(Scenes, DesignScene,
                          });
 
 void expect_same_tree(const ModelTree& a, const ModelTree& b, const std::string& what) {
-    ASSERT_EQ(a.nodes.size(), b.nodes.size()) << what;
-    ASSERT_EQ(a.prims, b.prims) << what;
-    std::size_t bad = 0;
-    for (std::size_t i = 0; i < a.nodes.size(); ++i) {
-        const ModelNode &x = a.nodes[i], &y = b.nodes[i];
-        bad += !(x.region.lo == y.region.lo && x.region.hi == y.region.hi && x.leaf == y.leaf && x.count == y.count &&
-                 x.first == y.first && x.axis == y.axis && x.split == y.split);
-    }
-    EXPECT_EQ(bad, 0u) << what;
+    EXPECT_EQ(model_tree_differences(a, b), 0u) << what;
 }
 
 TEST(Design, SameSeedSameStructure) {

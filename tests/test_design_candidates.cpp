@@ -9,16 +9,7 @@
 namespace rtcost::test {
 namespace {
 
-bool same_tree(const ModelTree& a, const ModelTree& b) {
-    if (a.nodes.size() != b.nodes.size() || a.prims != b.prims) return false;
-    for (std::size_t i = 0; i < a.nodes.size(); ++i) {
-        const ModelNode &x = a.nodes[i], &y = b.nodes[i];
-        if (!(x.region.lo == y.region.lo && x.region.hi == y.region.hi && x.leaf == y.leaf && x.count == y.count &&
-              x.first == y.first))
-            return false;
-    }
-    return true;
-}
+bool same_tree(const ModelTree& a, const ModelTree& b) { return model_tree_differences(a, b) == 0; }
 
 TEST(DesignCandidates, AutoIsTheTreeOfOneOfItsCountsAndNotAlwaysEight) {
     // Each auto design is the very tree one of the fixed counts designs; and the choice is made:

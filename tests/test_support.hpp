@@ -150,6 +150,19 @@ inline void expect_variants_match_brute(const Scene& s, std::span<const Ray> ray
     }
 }
 
+/// How many nodes of two model trees differ (region, leaf, children or primitives, plane), or
+/// SIZE_MAX when their node counts or primitive lists differ: 0 for the same tree.
+inline std::size_t model_tree_differences(const ModelTree& a, const ModelTree& b) {
+    if (a.nodes.size() != b.nodes.size() || a.prims != b.prims) return SIZE_MAX;
+    std::size_t bad = 0;
+    for (std::size_t i = 0; i < a.nodes.size(); ++i) {
+        const ModelNode &x = a.nodes[i], &y = b.nodes[i];
+        bad += !(x.region.lo == y.region.lo && x.region.hi == y.region.hi && x.leaf == y.leaf && x.count == y.count &&
+                 x.first == y.first && x.axis == y.axis && x.split == y.split);
+    }
+    return bad;
+}
+
 /// The counters of one closest-hit query of `r`; `hit` is reset first and receives the hit.
 inline RayCounters count_one(const Hierarchy& h, const Ray& r, Hit& hit) {
     RayCounters c;
