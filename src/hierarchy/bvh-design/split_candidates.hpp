@@ -30,6 +30,7 @@ struct CutScratch {
     std::vector<Bin> bins;
     std::vector<float> suffix_area;
     std::vector<std::uint32_t> suffix_n;
+    std::vector<Box3> prefix_box, suffix_box;  // per axis: bins [0, b] and [b, nbins)
     std::vector<Cut> all;  // without boxes: a node's bins give 45 cuts, of which a few are kept
     std::vector<std::uint32_t> order;
     std::vector<float> right_area;
@@ -142,6 +143,8 @@ inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t beg
     sc.bins.assign(3 * nbins, CutScratch::Bin{});
     sc.suffix_area.resize(nbins + 1);
     sc.suffix_n.resize(nbins + 1);
+    sc.prefix_box.resize(3 * nbins);
+    sc.suffix_box.resize(3 * nbins);
     // One pass over the primitives fills the three axes' bins.
     float lo[3], scale[3];
     for (int axis = 0; axis < 3; ++axis) {
@@ -162,8 +165,11 @@ inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t beg
     for (int axis = 0; axis < 3; ++axis) {
         if (!(cb.hi[axis] - lo[axis] > 0)) continue;
         const CutScratch::Bin* bins = sc.bins.data() + axis * nbins;
-        // The running box in a local (read back from the array it had just gone to, it waited on
-        // the store every bin), and only its area kept: boxes are made for the kept cuts alone.
+        Box3* prefix_box = sc.prefix_box.data() + axis * nbins;
+        Box3* suffix_box = sc.suffix_box.data() + axis * nbins;
+        // The running boxes in locals, only stored (read back from the array they had just gone
+        // to, they waited on the store every bin): a kept cut's boxes are then two lookups
+        // rather than a pass over the bins each (32 kept cuts took 512 box unions a node).
         Box3 suffix;
         std::uint32_t suffix_n = 0;
         sc.suffix_area[nbins] = suffix.area();
@@ -171,6 +177,7 @@ inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t beg
         for (int b = nbins - 1; b >= 0; --b) {
             suffix.extend(bins[b].box);
             suffix_n += bins[b].n;
+            suffix_box[b] = suffix;
             sc.suffix_area[b] = suffix.area();
             sc.suffix_n[b] = suffix_n;
         }
@@ -178,6 +185,7 @@ inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t beg
         std::uint32_t n = 0;
         for (int b = 0; b + 1 < nbins; ++b) {
             prefix.extend(bins[b].box);
+            prefix_box[b] = prefix;
             n += bins[b].n;
             if (n == 0 || sc.suffix_n[b + 1] == 0) continue;
             sc.all.push_back({axis, b + 1, false, prefix.area() * n + sc.suffix_area[b + 1] * sc.suffix_n[b + 1], Box3{},
@@ -187,12 +195,8 @@ inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t beg
     cuts.clear();
     keep_cheapest(keep, sc, cuts);
     for (Cut& cut : cuts) {
-        const CutScratch::Bin* bins = sc.bins.data() + cut.axis * nbins;
-        Box3 left, right;  // locals, as above
-        for (int b = 0; b < cut.at; ++b) left.extend(bins[b].box);
-        for (int b = cut.at; b < nbins; ++b) right.extend(bins[b].box);
-        cut.left = left;
-        cut.right = right;
+        cut.left = sc.prefix_box[cut.axis * nbins + cut.at - 1];
+        cut.right = sc.suffix_box[cut.axis * nbins + cut.at];
     }
 }
 
