@@ -176,7 +176,8 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
             });
             mid = static_cast<std::uint32_t>(it - ids.begin());
         }
-        if (orders) orders->split(ids, begin, mid, end);
+        // No sample segment reaches a node below one that none reaches, and such nodes never sweep.
+        if (orders && !rays.empty()) orders->split(ids, begin, mid, end);
         next.begin[0] = begin;
         next.begin[1] = mid;
         return mid;

@@ -27,13 +27,13 @@ struct Cut {
 // Buffers of binned_cuts and swept_cuts, reused from node to node.
 struct CutScratch {
     struct Bin {
-        Box3 box;
+        Box4 box;
         std::uint32_t n = 0;
     };
     std::vector<Bin> bins;
     std::vector<float> suffix_area;
     std::vector<std::uint32_t> suffix_n;
-    std::vector<Box3> prefix_box, suffix_box;  // per axis: bins [0, b] and [b, nbins)
+    std::vector<Box4> prefix_box, suffix_box;  // per axis: bins [0, b] and [b, nbins)
     // A bin boundary's cut without boxes: a node's bins give 45 cuts, of which a few are kept.
     struct BinCut {
         float sah;
@@ -60,11 +60,16 @@ inline void keep_cheapest(std::size_t keep, int nbins, CutScratch& sc, std::vect
         std::memcpy(&bits, &cost, sizeof bits);
         sc.keys[i] = std::uint64_t{bits} << 32 | i;
     }
-    std::partial_sort(sc.keys.begin(), sc.keys.begin() + static_cast<std::ptrdiff_t>(keep), sc.keys.end());
+    if (keep == 1)  // a node no sample segment reaches (most nodes)
+        std::iter_swap(sc.keys.begin(), std::min_element(sc.keys.begin(), sc.keys.end()));
+    else if (2 * keep >= sc.keys.size())
+        std::sort(sc.keys.begin(), sc.keys.end());
+    else
+        std::partial_sort(sc.keys.begin(), sc.keys.begin() + static_cast<std::ptrdiff_t>(keep), sc.keys.end());
     for (std::size_t i = 0; i < keep; ++i) {
         const CutScratch::BinCut& c = sc.all[static_cast<std::uint32_t>(sc.keys[i])];
-        cuts.push_back(Cut{c.axis, c.at, false, c.sah, sc.prefix_box[c.axis * nbins + c.at - 1],
-                           sc.suffix_box[c.axis * nbins + c.at], c.n_left, c.n_right});
+        cuts.push_back(Cut{c.axis, c.at, false, c.sah, sc.prefix_box[c.axis * nbins + c.at - 1].box3(),
+                           sc.suffix_box[c.axis * nbins + c.at].box3(), c.n_left, c.n_right});
     }
 }
 
@@ -193,37 +198,37 @@ inline void binned_cuts(const std::vector<std::uint32_t>& ids, std::uint32_t beg
         for (int axis = 0; axis < 3; ++axis) {
             const int b = std::min(nbins - 1, static_cast<int>((c[axis] - lo[axis]) * scale[axis]));
             CutScratch::Bin& bin = sc.bins[axis * nbins + b];
-            bin.box.extend(bounds);
+            extend(bin.box, bounds);
             ++bin.n;
         }
     }
     for (int axis = 0; axis < 3; ++axis) {
         if (!(cb.hi[axis] - lo[axis] > 0)) continue;
         const CutScratch::Bin* bins = sc.bins.data() + axis * nbins;
-        Box3* prefix_box = sc.prefix_box.data() + axis * nbins;
-        Box3* suffix_box = sc.suffix_box.data() + axis * nbins;
+        Box4* prefix_box = sc.prefix_box.data() + axis * nbins;
+        Box4* suffix_box = sc.suffix_box.data() + axis * nbins;
         // The running boxes in locals, only stored (read back from the array they had just gone
         // to, they waited on the store every bin): a kept cut's boxes are then two lookups
         // rather than a pass over the bins each (32 kept cuts took 512 box unions a node).
-        Box3 suffix;
+        Box4 suffix;
         std::uint32_t suffix_n = 0;
-        sc.suffix_area[nbins] = suffix.area();
+        sc.suffix_area[nbins] = 0;
         sc.suffix_n[nbins] = 0;
         for (int b = nbins - 1; b >= 0; --b) {
-            suffix.extend(bins[b].box);
+            suffix.extend(bins[b].box.lo, bins[b].box.hi);
             suffix_n += bins[b].n;
             suffix_box[b] = suffix;
-            sc.suffix_area[b] = suffix.area();
+            sc.suffix_area[b] = suffix_n ? area_of(suffix) : 0;  // Box3::area(): 0 when empty
             sc.suffix_n[b] = suffix_n;
         }
-        Box3 prefix;
+        Box4 prefix;
         std::uint32_t n = 0;
         for (int b = 0; b + 1 < nbins; ++b) {
-            prefix.extend(bins[b].box);
+            prefix.extend(bins[b].box.lo, bins[b].box.hi);
             prefix_box[b] = prefix;
             n += bins[b].n;
             if (n == 0 || sc.suffix_n[b + 1] == 0) continue;
-            sc.all.push_back({prefix.area() * n + sc.suffix_area[b + 1] * sc.suffix_n[b + 1], axis, b + 1, n, sc.suffix_n[b + 1]});
+            sc.all.push_back({area_of(prefix) * n + sc.suffix_area[b + 1] * sc.suffix_n[b + 1], axis, b + 1, n, sc.suffix_n[b + 1]});
         }
     }
     cuts.clear();
