@@ -1,8 +1,12 @@
 // bvh-design's candidate splits (src/hierarchy/bvh-design/split_candidates.hpp): the centroid
-// orders stay sorted as nodes split, and a sweep finds the split a full-sweep SAH build takes.
+// orders stay sorted as nodes split, a sweep finds the split a full-sweep SAH build takes, and
+// the kept cuts of the bins and of the sweep are the cheapest, with the boxes and counts of the
+// primitives on their sides.
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <string>
+#include <utility>
 
 #include "hierarchy/bvh-design/split_candidates.hpp"
 #include "rtcost/io.hpp"
@@ -89,6 +93,104 @@ TEST(SplitCandidates, CheapestSweptCutIsTheFullSweepSahSplit) {
     const bvh::Node& l = sah.nodes[sah.nodes[0].index];
     EXPECT_EQ(l.box.lo, left.lo);
     EXPECT_EQ(l.box.hi, left.hi);
+}
+
+// Every bin boundary of ids[begin, end) on every axis, made directly from the primitives: the
+// cuts binned_cuts chooses from, in its order of generation (axis, then bin).
+std::vector<Cut> every_bin_cut(const std::vector<std::uint32_t>& ids, std::uint32_t begin, std::uint32_t end,
+                               const PrimInfo& info, const Box3& cb, int nbins) {
+    std::vector<Cut> all;
+    for (int axis = 0; axis < 3; ++axis) {
+        const float ext = cb.hi[axis] - cb.lo[axis];
+        if (!(ext > 0)) continue;
+        const float scale = nbins / ext;
+        for (int at = 1; at < nbins; ++at) {
+            Cut c{axis, at, false, 0, Box3{}, Box3{}, 0, 0};
+            for (std::uint32_t i = begin; i < end; ++i) {
+                const std::uint32_t id = ids[i];
+                const int b = std::min(nbins - 1, static_cast<int>((info.centroids[id][axis] - cb.lo[axis]) * scale));
+                if (b < at) c.left.extend(info.bounds[id]), ++c.n_left;
+                else c.right.extend(info.bounds[id]), ++c.n_right;
+            }
+            if (c.n_left == 0 || c.n_right == 0) continue;
+            c.sah = c.left.area() * c.n_left + c.right.area() * c.n_right;
+            all.push_back(c);
+        }
+    }
+    return all;
+}
+
+void expect_same_cut(const Cut& got, const Cut& want, const std::string& what) {
+    EXPECT_EQ(got.axis, want.axis) << what;
+    EXPECT_EQ(got.at, want.at) << what;
+    EXPECT_EQ(got.swept, want.swept) << what;
+    EXPECT_EQ(got.n_left, want.n_left) << what;
+    EXPECT_EQ(got.n_right, want.n_right) << what;
+    EXPECT_EQ(got.left.lo, want.left.lo) << what;
+    EXPECT_EQ(got.left.hi, want.left.hi) << what;
+    EXPECT_EQ(got.right.lo, want.right.lo) << what;
+    EXPECT_EQ(got.right.hi, want.right.hi) << what;
+    EXPECT_FLOAT_EQ(got.sah, want.sah) << what;
+}
+
+// binned_cuts keeps the `keep` cheapest bin boundaries, cheapest first and ties in the order of
+// generation, each with the boxes and counts of its sides; a smaller keep keeps a prefix of a
+// larger one's (bvh-design's held-out counts compare nested candidate lists). On the root and on
+// a small node (most nodes hold a few primitives, and many bins are empty).
+TEST(SplitCandidates, BinnedCutsAreTheCheapestBinBoundariesWithTheirSides) {
+    const Scene s = builtin_scene("tetra", 4);
+    const PrimInfo info(s);
+    std::vector<std::uint32_t> ids(s.size());
+    for (std::uint32_t i = 0; i < s.size(); ++i) ids[i] = i;
+    const auto n = static_cast<std::uint32_t>(ids.size());
+    ASSERT_GT(n, 100u);
+    const int nbins = 16;
+    CutScratch scratch;
+    for (const auto& [begin, end] : {std::pair<std::uint32_t, std::uint32_t>{0, n}, {n / 3, n / 3 + 7}}) {
+        Box3 cb;
+        for (std::uint32_t i = begin; i < end; ++i) cb.extend(info.centroids[ids[i]]);
+        std::vector<Cut> want = every_bin_cut(ids, begin, end, info, cb, nbins);
+        ASSERT_GE(want.size(), 3u);
+        std::stable_sort(want.begin(), want.end(), [](const Cut& a, const Cut& b) { return a.sah < b.sah; });
+        std::vector<Cut> widest;
+        for (std::size_t keep : {std::size_t{1}, std::size_t{3}, std::size_t{8}, std::size_t{32}, std::size_t{100}}) {
+            std::vector<Cut> cuts;
+            bvh::binned_cuts(ids, begin, end, info, cb, nbins, keep, scratch, cuts);
+            ASSERT_EQ(cuts.size(), std::min(keep, want.size())) << "keep " << keep;
+            for (std::size_t c = 0; c < cuts.size(); ++c)
+                expect_same_cut(cuts[c], want[c], "node [" + std::to_string(begin) + ", " + std::to_string(end) +
+                                                      "), keep " + std::to_string(keep) + ", cut " + std::to_string(c));
+            if (cuts.size() > widest.size()) widest = cuts;
+        }
+        EXPECT_EQ(widest.size(), want.size());
+    }
+}
+
+// Every cut swept_cuts keeps, not only the cheapest, has the boxes and counts of the first `at`
+// primitives in its axis's centroid order and of the rest, and they are the cheapest splits.
+TEST(SplitCandidates, EverySweptCutBoundsItsSides) {
+    const Scene s = builtin_scene("balls", 2);
+    const PrimInfo info(s);
+    std::vector<std::uint32_t> ids(s.size());
+    for (std::uint32_t i = 0; i < s.size(); ++i) ids[i] = i;
+    const AxisOrders orders(ids, info);
+    const auto n = static_cast<std::uint32_t>(ids.size());
+    std::vector<Cut> want;
+    for (int axis = 0; axis < 3; ++axis) {
+        const auto sorted = orders.of(axis, 0, n);
+        for (std::uint32_t at = 1; at < n; ++at) {
+            Cut c{axis, static_cast<int>(at), true, 0, Box3{}, Box3{}, at, n - at};
+            for (std::uint32_t i = 0; i < n; ++i) (i < at ? c.left : c.right).extend(info.bounds[sorted[i]]);
+            c.sah = c.left.area() * c.n_left + c.right.area() * c.n_right;
+            want.push_back(c);
+        }
+    }
+    std::stable_sort(want.begin(), want.end(), [](const Cut& a, const Cut& b) { return a.sah < b.sah; });
+    CutScratch scratch;
+    std::vector<Cut> cuts;
+    bvh::swept_cuts(orders, 0, n, info, 5, scratch, cuts);
+    ASSERT_EQ(cuts.size(), 5u);
+    for (std::size_t c = 0; c < cuts.size(); ++c) expect_same_cut(cuts[c], want[c], "cut " + std::to_string(c));
 }
 
 }  // namespace
