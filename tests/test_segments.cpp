@@ -256,7 +256,7 @@ TEST(ModelSegments, TheReachedTreePredictsWhatTheWholeTreePredicts) {
         for (Query q : {Query::Closest, Query::Any, Query::All}) {
             const std::string what = name + " " + ::testing::PrintToString(set) + " query " +
                                      std::to_string(static_cast<int>(q));
-            SegmentsPredictor predictor(*h, s, smp);
+            SegmentsPredictor predictor(*h, s, smp, 0, SegmentsPredictor::Via::ModelTree);
             const std::size_t reached = predictor.tree().nodes.size();
             EXPECT_LE(reached, whole.nodes.size()) << what;
             // A 5D tree keeps only the paths of the sample's rays (their 5D points' cells).
@@ -285,6 +285,58 @@ TEST(ModelSegments, TheReachedTreePredictsWhatTheWholeTreePredicts) {
     EXPECT_GE(pruned_trees, 5u);
 }
 
+// The default predictor replays the sample through each hierarchy's own traversal where it
+// can, instead of materialising the model tree: the same prediction (kd-trees within rounding,
+// their traversal widening each plane crossing by a few ulps) for every hierarchy and query,
+// and the model tree's own where the traversal is not the model's (mailboxes, bvh-design's
+// order bytes, rc5d) or the query never ends (Query::All: a BVH's traversal walks a polygon's
+// edges up to the nearest hit so far, its model tree to the segment's end).
+TEST(ModelSegments, TheTraversalsReplayPredictsWhatTheModelTreePredicts) {
+    Scene s = builtin_scene("balls", 3);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    const RaySample smp = draw_sample_from(s, mixed_rays(s), 300, 5, *ref);
+    std::vector<std::uint32_t> idx(smp.size());
+    for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    std::vector<Variant> variants = modelled_variants(s);
+    variants.push_back({"grid", {"mailbox=1"}});
+    variants.push_back({"kd-sah", {"mailbox=1"}});
+    variants.push_back({"octree", {"mailbox=1"}});
+    std::size_t replayed = 0, modelled = 0;
+    for (const auto& [name, set] : variants) {
+        auto h = build_hierarchy(s, name, set);
+        for (Query q : {Query::Closest, Query::Any, Query::All}) {
+            const std::string what = name + " " + ::testing::PrintToString(set) + " query " +
+                                     std::to_string(static_cast<int>(q));
+            ModelOptions o;
+            o.query = q;
+            SegmentsPredictor traversal(*h, s, smp), tree(*h, s, smp, 0, SegmentsPredictor::Via::ModelTree);
+            const Prediction a = traversal.predict(idx, o), b = tree.predict(idx, o);
+            const bool by_traversal = a.note.find("the hierarchy's traversal") != std::string::npos;
+            RayCounters unused;
+            EXPECT_EQ(by_traversal, q != Query::All && h->replay(smp, idx, q, unused)) << what;
+            replayed += by_traversal;
+            modelled += !by_traversal;
+            const bool mailboxed = std::find(set.begin(), set.end(), "mailbox=1") != set.end();
+            EXPECT_FALSE(by_traversal && mailboxed) << what << ": a mailboxed traversal is not the model";
+            const double tolerance = name.starts_with("kd-") ? 1e-3 : 1e-6;
+            EXPECT_NEAR(a.scalar, b.scalar, tolerance * b.scalar) << what;
+            EXPECT_NEAR(a.cost.steps, b.cost.steps, tolerance * b.cost.steps) << what;
+            EXPECT_NEAR(a.cost.box, b.cost.box, tolerance * b.cost.box + 1e-9) << what;
+            EXPECT_NEAR(a.cost.prim_tests(), b.cost.prim_tests(), tolerance * b.cost.prim_tests() + 1e-9) << what;
+            EXPECT_NEAR(a.cost.polygon_edges, b.cost.polygon_edges, tolerance * b.cost.polygon_edges + 1e-9) << what;
+            // (The model tree's list may end in depths no ray reaches.)
+            auto at = [](const std::vector<double>& v, std::size_t d) { return d < v.size() ? v[d] : 0.0; };
+            ASSERT_FALSE(a.visits_by_depth.empty()) << what;
+            for (std::size_t d = 0; d < std::max(a.visits_by_depth.size(), b.visits_by_depth.size()); ++d)
+                EXPECT_NEAR(at(a.visits_by_depth, d), at(b.visits_by_depth, d), tolerance * at(b.visits_by_depth, d) + 1e-9)
+                    << what << " depth " << d;
+            EXPECT_EQ(traversal.tree_seconds() == 0, by_traversal) << what << ": a replay materialises nothing";
+        }
+    }
+    EXPECT_GE(replayed, 2u * 10);  // the BVHs, kd-trees, grids, octrees and BSP trees
+    EXPECT_GE(modelled, 3u * 4);   // the mailboxed three, rc5d, bvh-wide; every hierarchy's All
+}
+
 // Where a BVH is far larger than its sample, only the part the sample reaches is materialised,
 // and that part holds every node a closest-hit replay enters: the overlapping children searched
 // before the hit is found, beyond the ray's end. Camera rays of a scene of many small spheres.
@@ -300,7 +352,7 @@ TEST(ModelSegments, AReachedBvhHoldsWhatTheReplayEntersBeforeItsHit) {
     for (const char* name : {"bvh-sah", "bvh-median", "bvh-gs", "bvh-wide", "bvh-design"}) {
         auto h = build_hierarchy(s, name);
         const ModelTree whole = h->model_tree();
-        SegmentsPredictor predictor(*h, s, smp);
+        SegmentsPredictor predictor(*h, s, smp, 0, SegmentsPredictor::Via::ModelTree);
         const std::size_t reached = predictor.tree().nodes.size();
         EXPECT_LT(reached, whole.nodes.size() / 2) << name;
         ModelOptions o;

@@ -23,6 +23,8 @@
 
 namespace rtcost {
 
+struct RaySample;  // sample.hpp
+
 /// What a query asks for.
 enum class Query {
     Closest,  ///< nearest hit in (tmin, tmax)
@@ -127,6 +129,19 @@ public:
     /// in one traversal and keeps every primitive met at the same parameter as another; the
     /// others restart a closest-hit query at each crossing found, which keeps one of such ties.
     virtual std::size_t crossings(const Ray& ray, std::span<Crossing> out) const;
+
+    /// Adds to `counters` the operations of the sample rays `rays` (indices into `sample`), each
+    /// traced with `query` by this hierarchy's own traversal, every primitive test answered from
+    /// the ray's known crossings instead of intersecting. That is the segments estimator's
+    /// prediction (Preset::Exact) without materialising a model tree: how SegmentsPredictor
+    /// predicts where it can. Returns false, counting nothing, where the hierarchy has no such
+    /// replay or its replay is not its model tree's prediction (mailboxes, an order for
+    /// occlusion rays the model does not know).
+    virtual bool replay(const RaySample& sample, std::span<const std::uint32_t> rays, Query query,
+                        RayCounters& counters) const {
+        (void)sample, (void)rays, (void)query, (void)counters;
+        return false;
+    }
 
     /// Structural statistics (N_IN, N_V, N_EV, N_OIV, depth, bytes, build seconds).
     StructureStats structure() const {

@@ -213,24 +213,40 @@ Prediction predict_segments(const ModelTree& tree, const Scene& scene, const Ray
 /// tree either way.
 class SegmentsPredictor {
 public:
-    /// Materialises the part of `h`'s model tree that `sample` can reach. `h`, `scene` and
-    /// `sample` must outlive the predictor. `nodes`: the hierarchy's nodes when the caller has
-    /// its structure() already (0: counted here, a walk over the whole hierarchy).
-    SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample, std::size_t nodes = 0);
+    /// How a prediction is made.
+    enum class Via {
+        /// The hierarchy's own traversal replays the sample (Hierarchy::replay) where it can and
+        /// the preset is Exact: the same prediction, within rounding, without materialising the
+        /// model tree (a tenth of the time on a BVH). The model tree elsewhere.
+        Traversal,
+        /// Always the part of the model tree the sample reaches, materialised.
+        ModelTree,
+    };
+    /// `h`, `scene` and `sample` must outlive the predictor. `nodes`: the hierarchy's nodes when
+    /// the caller has its structure() already (0: counted here, a walk over the whole
+    /// hierarchy). The model tree is materialised when a prediction first needs it.
+    SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample, std::size_t nodes = 0,
+                      Via via = Via::Traversal);
     /// predict_segments over the sample's rays `rays`.
     Prediction predict(std::span<const std::uint32_t> rays, const ModelOptions& opt, const UnitCosts& costs = {});
     /// Seconds spent materialising trees so far (the reached one, and the whole one if needed).
     double tree_seconds() const { return tree_seconds_; }
-    /// The tree predictions are made on (pruned until a replay needed the whole one).
-    const ModelTree& tree() const { return tree_; }
+    /// The tree predictions through the model tree are made on (pruned until a replay needed the
+    /// whole one), materialised if no prediction has needed it yet.
+    const ModelTree& tree();
     /// A hierarchy of at most this many nodes per sample ray is materialised whole.
     static constexpr std::size_t kWholeNodesPerRay = 16;
 
 private:
+    void materialise();
+
     const Hierarchy& h_;
     const Scene& scene_;
     const RaySample& sample_;
+    std::size_t nodes_;
+    Via via_;
     ModelTree tree_;
+    bool materialised_ = false;
     bool whole_ = false;
     double tree_seconds_ = 0;
 };

@@ -55,7 +55,7 @@ private:
         Count counting{counters};
         for (std::size_t i = 0; i < sample_.size(); ++i) {
             const std::span<const Crossing> known = sample_.crossings_of(i);
-            const KnownTest test{known, kinds_, scene_};
+            const KnownTest test{known, kinds_.data(), scene_};
             const Ray& ray = sample_.rays.rays[i];
             Hit hit;
             switch (sample_.queries[i]) {
@@ -67,22 +67,6 @@ private:
         counters.rays = sample_.size();
         return measured_cost(counters);
     }
-
-    // The segments estimator's answer to a primitive test, counted.
-    struct KnownTest {
-        std::span<const Crossing> known;
-        const std::vector<std::uint8_t>& kinds;
-        const Scene& scene;
-        bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, Count& c) const {
-            const auto kind = static_cast<PrimKind>(kinds[id]);
-            c.prim(kind);
-            if (kind == PrimKind::Polygon) c.edges(scene.edges_walked(id, up_to_hit(ray, hit)));
-            return model::known_crossing_hit(known, id, ray, hit);
-        }
-        /// A traversal of a tree built only where the sample reaches (subdiv::CellOptions::
-        /// reached) entered a cell left unbuilt: its price would be wrong.
-        [[noreturn]] void unbuilt() const { throw model::PrunedNodeReached{}; }
-    };
 
     const Scene& scene_;
     const RaySample& sample_;

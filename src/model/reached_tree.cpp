@@ -308,22 +308,65 @@ ModelTree reached_model_tree(const Hierarchy& h, const Scene& scene, const RaySa
 }  // namespace
 
 SegmentsPredictor::SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample,
-                                     std::size_t nodes)
-    : h_(h), scene_(scene), sample_(sample) {
+                                     std::size_t nodes, Via via)
+    : h_(h), scene_(scene), sample_(sample), nodes_(nodes), via_(via) {}
+
+void SegmentsPredictor::materialise() {
+    if (materialised_) return;
     const auto start = std::chrono::steady_clock::now();
     // A tree of a few nodes per sample ray (a BVH) is reached nearly everywhere: finding where
     // the segments reach would repeat the replay's clipping for nothing, so it is taken whole.
+    std::size_t nodes = nodes_;
     if (nodes == 0) {
-        const StructureStats st = h.structure();
+        const StructureStats st = h_.structure();
         nodes = st.interior + st.leaves;
     }
-    whole_ = nodes <= kWholeNodesPerRay * std::max<std::size_t>(sample.size(), 1);
-    tree_ = whole_ ? h.model_tree() : reached_model_tree(h, scene, sample);
+    whole_ = nodes <= kWholeNodesPerRay * std::max<std::size_t>(sample_.size(), 1);
+    tree_ = whole_ ? h_.model_tree() : reached_model_tree(h_, scene_, sample_);
+    materialised_ = true;
     tree_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+const ModelTree& SegmentsPredictor::tree() {
+    materialise();
+    return tree_;
+}
+
+namespace {
+
+/// The prediction of a replay's counters: what the model tree's recursion reports, per ray.
+Prediction replayed(const RayCounters& counters, std::size_t rays, const UnitCosts& costs) {
+    Prediction p;
+    p.cost = measured_cost(counters);
+    p.scalar = costs.scalar(p.cost);
+    const double n = counters.rays ? static_cast<double>(counters.rays) : 1.0;
+    for (int d = 0; d < kMaxStatDepth; ++d) p.visits_by_depth.push_back(counters.visits[d] / n);
+    while (!p.visits_by_depth.empty() && p.visits_by_depth.back() == 0) p.visits_by_depth.pop_back();
+    p.preset = "exact";
+    p.estimator = "segments";
+    p.note = "probabilities from " + std::to_string(rays) +
+             " sampled segments replayed through the hierarchy's traversal, each ending where its known crossings "
+             "end it (no primitive tests)";
+    return p;
+}
+
+}  // namespace
+
 Prediction SegmentsPredictor::predict(std::span<const std::uint32_t> rays, const ModelOptions& opt,
                                       const UnitCosts& costs) {
+    // (Not Query::All: a BVH's traversal that never ends walks a polygon's edges only up to the
+    // nearest hit so far, where the model tree's probe walks them to the segment's end.)
+    if (via_ == Via::Traversal && opt.preset == Preset::Exact && opt.query != Query::All) {
+        for (std::uint32_t i : rays)
+            if (i >= sample_.size()) throw std::out_of_range("predict_segments: ray index beyond the sample");
+        RayCounters counters;
+        try {
+            if (h_.replay(sample_, rays, opt.query, counters)) return replayed(counters, rays.size(), costs);
+        } catch (const model::PrunedNodeReached&) {
+            // A cell the hierarchy left unbuilt where its own sample did not reach: the model tree.
+        }
+    }
+    materialise();
     if (!whole_) {
         try {
             return predict_segments(tree_, scene_, sample_, rays, opt, costs);

@@ -30,6 +30,10 @@ public:
     std::string_view name() const override { return "bvh-design"; }
     bool emit_model(ModelSink& sink) const override { return bvh_.emit_model(sink); }
 
+    /// The order bytes are outside the model tree (it takes the children front to back): its
+    /// replay is not the model's prediction.
+    bool replay_is_model() const { return false; }
+
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
         return trace_with<C, Q>(ray, hit, counting, RealPrimTest{scene()});

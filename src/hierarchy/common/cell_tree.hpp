@@ -95,6 +95,10 @@ public:
         return trace_with<C, Q>(ray, hit, counting, RealPrimTest{*this->scene_});
     }
 
+    /// Whether Hierarchy::replay is the model tree's prediction: not with mailboxes, which the
+    /// model does not know.
+    bool replay_is_model() const { return !o_.mailbox; }
+
     /// The traversal with the primitive test supplied by the caller (design/replay.hpp).
     template <class C, Query Q, class PrimTest>
     bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {

@@ -3,7 +3,9 @@
 // traversal template, and the primitive test every traversal's leaves share. Internal to the
 // library (not installed): the public interface is rtcost/hierarchy.hpp.
 
+#include "../../model/model_internal.hpp"
 #include "rtcost/hierarchy.hpp"
+#include "rtcost/sample.hpp"
 #include "rtcost/stats.hpp"
 
 namespace rtcost {
@@ -47,6 +49,11 @@ public:
     /// One closest-hit traversal whose primitive test collects the crossings (CrossingCollector)
     /// where the traversal takes its test (`trace_with`); restarted queries otherwise.
     std::size_t crossings(const Ray& ray, std::span<Crossing> out) const final;
+
+    /// Each sample ray through `trace_with` with KnownTest, where the hierarchy has it and its
+    /// replay is the model tree's prediction (`Derived::replay_is_model()`, true if absent).
+    bool replay(const RaySample& sample, std::span<const std::uint32_t> rays, Query query,
+                RayCounters& counters) const final;
 
 private:
     const Derived& self() const { return static_cast<const Derived&>(*this); }
@@ -127,6 +134,55 @@ private:
         return true;
     }
 };
+
+/// The segments estimator's primitive test: answered from the ray's known crossings (where the
+/// ray sample found it meets each primitive) instead of intersecting, and counted as test_prim
+/// counts a real test. A traversal that takes it replays a sample ray as the model's probe
+/// replays it through the hierarchy's model tree (tests/test_replay.cpp).
+struct KnownTest {
+    std::span<const Crossing> known;
+    /// Each primitive's PrimKind as a byte, or null to read the scene's (its records are far
+    /// larger, and a replay looks up a kind for every reference of every leaf it visits).
+    const std::uint8_t* kinds;
+    const Scene& scene;
+    bool operator()(std::uint32_t id, const Ray& ray, Hit& hit, Count& c) const {
+        const auto kind = kinds ? static_cast<PrimKind>(kinds[id]) : scene.kind(id);
+        c.prim(kind);
+        if (kind == PrimKind::Polygon) c.edges(scene.edges_walked(id, up_to_hit(ray, hit)));
+        return model::known_crossing_hit(known, id, ray, hit);
+    }
+    /// A traversal of a tree built only where the sample reaches (subdiv::CellOptions::reached)
+    /// entered a cell left unbuilt: its count would be wrong.
+    [[noreturn]] void unbuilt() const { throw model::PrunedNodeReached{}; }
+};
+
+template <class Derived>
+bool HierarchyImpl<Derived>::replay(const RaySample& sample, std::span<const std::uint32_t> rays, Query query,
+                                    RayCounters& counters) const {
+    const Ray probe{};
+    if constexpr (requires(Hit& hit, Count& c, const KnownTest& test) {
+                      self().template trace_with<Count, Query::Closest>(probe, hit, c, test);
+                  }) {
+        if constexpr (requires { self().replay_is_model(); })
+            if (!self().replay_is_model()) return false;
+        Count counting{counters};
+        for (std::uint32_t i : rays) {
+            const KnownTest test{sample.crossings_of(i), nullptr, *scene_};
+            const Ray& ray = sample.rays.rays.at(i);
+            Hit hit;
+            ++counters.rays;
+            switch (query) {
+                case Query::Closest: self().template trace_with<Count, Query::Closest>(ray, hit, counting, test); break;
+                case Query::Any: self().template trace_with<Count, Query::Any>(ray, hit, counting, test); break;
+                case Query::All: self().template trace_with<Count, Query::All>(ray, hit, counting, test); break;
+            }
+        }
+        return true;
+    } else {
+        (void)sample, (void)rays, (void)query, (void)counters, (void)probe;
+        return false;
+    }
+}
 
 template <class Derived>
 std::size_t HierarchyImpl<Derived>::crossings(const Ray& ray, std::span<Crossing> out) const {

@@ -63,6 +63,10 @@ public:
         return trace_with<C, Q>(ray, hit, counting, RealPrimTest{*scene_});
     }
 
+    /// Whether Hierarchy::replay is the model tree's prediction: not with mailboxes, which the
+    /// model does not know.
+    bool replay_is_model() const { return !mailbox_; }
+
     /// The traversal with the primitive test supplied by the caller: `test(id, ray, hit,
     /// counting)` counts its test, records a hit nearer than `hit.t` and says whether it found
     /// one (design/replay.hpp).

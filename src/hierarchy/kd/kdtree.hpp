@@ -147,6 +147,11 @@ public:
         return trace_with<C, Q>(ray, hit, counting, RealPrimTest{*scene_});
     }
 
+    /// Whether Hierarchy::replay is the model tree's prediction (within rounding: the traversal
+    /// widens each plane crossing by a few ulps, tests/test_replay.cpp): not with mailboxes,
+    /// which the model does not know.
+    bool replay_is_model() const { return !mailbox_; }
+
     /// The traversal with the primitive test supplied by the caller (design/replay.hpp).
     template <class C, Query Q, class PrimTest>
     bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {
