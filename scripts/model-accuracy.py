@@ -160,11 +160,16 @@ def main():
                     f"({worst[2]} on {worst[0]} {worst[1]}) | {len(errs)} | {rhos[0]:.3f} | "
                     f"{rhos[len(rhos) // 2]:.3f} |\n")
         f.write("\n## Prediction time against tracing the whole distribution\n\n"
-                "Seconds of the segments prediction for one hierarchy (materialising the part of its model "
-                "tree that the sample reaches included; drawing the sample, once per scene and distribution, "
-                "not included) over the single-thread seconds of tracing every ray of the distribution "
-                "through it. The target is 2%; where the sample is itself 2% of the rays (every distribution "
-                "of fewer than 204,800 rays), replaying it costs about 2% of the traversal on its own.\n\n"
+                "Seconds of the segments prediction for one hierarchy over the single-thread seconds of "
+                "tracing every ray of the distribution through it. The prediction replays the sample through "
+                "the hierarchy's own traversal, each primitive test answered from the ray's known crossings "
+                "(`Hierarchy::replay`: the model tree's prediction, without materialising the tree), where "
+                "the traversal is the model's (not with mailboxes, nor bvh-wide's, bvh-design's order bytes or "
+                "rc5d's traversal); elsewhere it materialises the part of the model tree the sample reaches, "
+                "which the time includes. Drawing the sample, once per scene and distribution, is not "
+                "included. The target is 2%; where the sample is itself 2% of the rays (every distribution "
+                "of fewer than 204,800 rays), replaying it costs about 2% of the traversal on its own, more "
+                "where counting and the polygons' edge walks weigh.\n\n"
                 "| hierarchy | median share | runs within 2% | worst share | worst run |\n|---|---|---|---|---|\n")
         for h in names:
             shares = sorted((r[4]["segments"][2] / r[5], r) for r in rows if r[2] == h and r[5] > 0)

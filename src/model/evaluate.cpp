@@ -224,8 +224,9 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
         if (row.modelled) {
             if (opt.on_step) opt.on_step("model " + req.label());
             // The sampled estimator's probe indexes a materialised tree; the segments one the
-            // part of it that the sample reaches; the geometric one reads the hierarchy where
-            // it lies. Materialising a tree is part of what a probed prediction costs.
+            // hierarchy's own traversal where it can replay the sample, else the part of the
+            // tree that the sample reaches; the geometric one reads the hierarchy where it lies.
+            // Materialising a tree is part of what a probed prediction costs.
             const auto tree_start = std::chrono::steady_clock::now();
             const ModelTree tree = sampled ? h->model_tree() : ModelTree{};
             const double tree_seconds =
@@ -246,8 +247,8 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                 grow_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
             }
             if (visibility) seen.emplace(grown ? *grown : *h, scene, *visibility, grown ? 0 : nodes);
-            // A fallback on the whole tree is timed within the prediction that needed it.
-            const double reached_seconds = segments ? segments->tree_seconds() : 0.0;
+            // (The segments predictor materialises a tree, when it needs one, within the
+            // prediction that needed it, which that prediction's time holds.)
             for (Estimator est : opt.estimators) {
                 for (Preset preset : opt.presets) {
                     std::vector<std::pair<double, Prediction>> parts;
@@ -281,7 +282,6 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                     }
                     row.predictions.push_back(mix(parts, costs));
                     if (est == Estimator::Sampled) row.predictions.back().seconds += tree_seconds;
-                    if (est == Estimator::Segments) row.predictions.back().seconds += reached_seconds;
                     if (est == Estimator::Geometric && seen)
                         row.predictions.back().seconds += seen->tree_seconds() + grow_seconds;
                 }

@@ -1,4 +1,5 @@
 #pragma once
+#include <utility>
 // `grid-design`: the uniform grid whose per-axis resolution minimises the cost model's
 // prediction for a sample of the user's rays (design.hpp), traversed as `grid` is.
 
@@ -38,6 +39,13 @@ public:
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
         return g_->template trace<C, Q>(ray, hit, counting);
     }
+    /// The grid's traversal with the caller's primitive test, and whether its replay is the
+    /// model's (Hierarchy::replay, crossings).
+    template <class C, Query Q, class PrimTest>
+    bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest&& test) const {
+        return g_->template trace_with<C, Q>(ray, hit, counting, std::forward<PrimTest>(test));
+    }
+    bool replay_is_model() const { return g_->replay_is_model(); }
 
 protected:
     StructureStats compute_structure() const override { return g_->structure(); }
