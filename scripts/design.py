@@ -166,6 +166,12 @@ TRIED = ["", "## Tried and not kept", "",
          "prices cheaper: +10.35%, +9.87% and +7.14%, for 1.3x to 1.9x the design time on every distribution "
          "with occlusion rays. Counting occlusion rays to tmax in the order bytes' statistics too: balls shadow "
          "+2.7% -> -1.7%, the averages within 0.5 point. None kept.",
+         "- 2026-12-05, for design time, bvh-design's held-out choice of its candidate count among two counts "
+         "rather than 8, 16 and 32 (each is a build on half the sample). Operations against bvh-sah over the "
+         "60 bvh rows (SPD scenes and meshes): 8 or 32: +9.74% on average (three counts: +9.81%), spd +7.9% "
+         "(+8.2%), shadow rays at least 20% fewer on 4 scenes as before; within 10x bvh-sah's build on 21 of "
+         "60 rows (13). 8 or 16: +9.01%, spd +8.0%, shadow at least 20% on 1 scene; 23 of 60 rows. Not kept: "
+         "the design-time target is missed either way, and the third count designs the cheaper trees.",
          ]
 
 
