@@ -3,6 +3,7 @@
 // prediction through the candidate's model tree (sample_cost), for every structure priced so.
 #include "../src/design/replay.hpp"
 #include "../src/hierarchy/bsp/bsp.hpp"
+#include "../src/hierarchy/bvh-design/occlusion_order.hpp"
 #include "../src/hierarchy/bvh/bvh.hpp"
 #include "../src/hierarchy/grid/grid.hpp"
 #include "../src/hierarchy/kd/kdtree.hpp"
@@ -137,6 +138,36 @@ TEST(Replay, OfBvhsIsTheModelTreesPredictionAndTheTrace) {
             }
         });
     EXPECT_GE(samples, 8);
+}
+
+// bvh-design prices two orders of a tree for occlusion rays by replaying the other rays once:
+// a replay's occlusion and other rays add up to the whole sample's, leaves first or not changes
+// only the occlusion rays' counts, and bvh-sah's tree with its order bytes (DesignedBvh) counts
+// its other rays exactly as without them.
+TEST(Replay, OtherRaysCountAlikeInEveryOrderForOcclusionRays) {
+    using Rays = designing::SampleReplay::Rays;
+    const int samples = for_each_sample(
+        {"builtin:balls:2", "builtin:tetra:4", "gears"}, {"rays=spd"},
+        [&](const std::string& where, const Scene& s, const DesignInput& in) {
+            const designing::SampleReplay replay(s, in.sample, in.costs);
+            auto h = build_hierarchy(s, "bvh-sah");
+            auto* plain = dynamic_cast<bvh::Bvh*>(h.get());
+            ASSERT_NE(plain, nullptr);
+            RayCounters parts = replay.counters(*plain, Rays::Others);
+            const RayCounters others = parts;
+            const RayCounters occlusion = replay.counters(*plain, Rays::Occlusion);
+            parts += occlusion;
+            EXPECT_EQ(parts, replay.counters(*plain, Rays::All)) << where;
+            EXPECT_DOUBLE_EQ(replay.time(*plain, parts), replay.time(*plain)) << where;
+            EXPECT_GT(occlusion.box, 0u) << where;
+            plain->set_any_leaves_first(true);
+            EXPECT_EQ(replay.counters(*plain, Rays::Others), others) << where;
+            plain->set_any_leaves_first(false);
+            const bvh::DesignedBvh ordered(s, plain->data(), bvh::occlusion_bits(plain->data(), s, in.sample));
+            EXPECT_EQ(replay.counters(ordered, Rays::Others), others) << where;
+            EXPECT_GT(others.box, 0u) << where;
+        });
+    EXPECT_GE(samples, 2);  // gears where the SPD scenes are present
 }
 
 // kd-design's trees: kd-sah's with either empty bonus, and kd-median's. Not exactly the model

@@ -44,28 +44,48 @@ public:
     /// What a design compares built candidates by.
     template <class H>
     double time(const H& h) const {
-        const bool sized = costs_.cache > 0 || costs_.box_simd >= 0;
-        return costs_.scalar(counted(h), sized ? h.structure() : StructureStats{});
+        return time(h, counters(h, Rays::All));
     }
 
-private:
+    /// Which of the sample's rays a replay takes: all, its occlusion (any-hit) rays, or the others.
+    enum class Rays { All, Occlusion, Others };
+
+    /// The operations of the sample's `which` rays through `h`. Two orders of one tree for
+    /// occlusion rays count the other rays alike: counted once, they are added to each order's.
     template <class H>
-    CostVector counted(const H& h) const {
+    RayCounters counters(const H& h, Rays which) const {
         RayCounters counters;
         Count counting{counters};
         for (std::size_t i = 0; i < sample_.size(); ++i) {
-            const std::span<const Crossing> known = sample_.crossings_of(i);
-            const KnownTest test{known, kinds_.data(), scene_};
+            const Query q = sample_.queries[i];
+            if (which != Rays::All && (q == Query::Any) != (which == Rays::Occlusion)) continue;
+            const KnownTest test{sample_.crossings_of(i), kinds_.data(), scene_};
             const Ray& ray = sample_.rays.rays[i];
             Hit hit;
-            switch (sample_.queries[i]) {
+            switch (q) {
                 case Query::Closest: h.template trace_with<Count, Query::Closest>(ray, hit, counting, test); break;
                 case Query::Any: h.template trace_with<Count, Query::Any>(ray, hit, counting, test); break;
                 case Query::All: h.template trace_with<Count, Query::All>(ray, hit, counting, test); break;
             }
         }
-        counters.rays = sample_.size();
-        return measured_cost(counters);
+        return counters;
+    }
+
+    /// time(h) of `whole`: counters of every sample ray through `h` (e.g. its other rays' and
+    /// its occlusion rays' added up).
+    template <class H>
+    double time(const H& h, RayCounters whole) const {
+        const bool sized = costs_.cache > 0 || costs_.box_simd >= 0;
+        whole.rays = sample_.size();
+        return costs_.scalar(measured_cost(whole), sized ? h.structure() : StructureStats{});
+    }
+
+private:
+    template <class H>
+    CostVector counted(const H& h) const {
+        RayCounters whole = counters(h, Rays::All);
+        whole.rays = sample_.size();
+        return measured_cost(whole);
     }
 
     const Scene& scene_;

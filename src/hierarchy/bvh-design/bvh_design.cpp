@@ -302,11 +302,16 @@ const Registration reg{
              // Each priced by its own traversal of the sample (design/replay.hpp): the model's
              // prediction without materialising the trees' model trees.
              const designing::SampleReplay replay(s, in.sample, in.costs);
+             using Rays = designing::SampleReplay::Rays;
              for (Bvh* h : {designed.get(), by_sah.get()}) {  // a tie keeps the designed splits
+                 // The other rays go the same way in either order: replayed once.
+                 const RayCounters others = replay.counters(*h, Rays::Others);
                  for (bool leaves : {false, true}) {
                      if (!(leaves ? try_leaves : try_near)) continue;
                      h->set_any_leaves_first(leaves);
-                     const double c = replay.time(*h);
+                     RayCounters whole = others;
+                     whole += replay.counters(*h, Rays::Occlusion);
+                     const double c = replay.time(*h, whole);
                      if (!best.h || c < best.cost) best = {h, leaves, c};
                  }
              }
@@ -321,8 +326,15 @@ const Registration reg{
          auto sah_ordered = std::make_unique<DesignedBvh>(s, by_sah->data(), occlusion_bits(by_sah->data(), s, in.sample));
          std::vector<std::uint8_t> designed_order = occlusion_bits(designed_tree, s, in.sample);
          auto designed_ordered = std::make_unique<DesignedBvh>(s, std::move(designed_tree), std::move(designed_order));
-         const double c_designed = replay.time(*designed_ordered), c_sah_ordered = replay.time(*sah_ordered),
-                      c_sah = replay.time(*by_sah);
+         // bvh-sah's tree takes its other rays alike with its order bytes or without (DesignedBvh
+         // orders occlusion rays only): replayed once.
+         using Rays = designing::SampleReplay::Rays;
+         const RayCounters sah_others = replay.counters(*by_sah, Rays::Others);
+         RayCounters sah_ordered_whole = sah_others, sah_whole = sah_others;
+         sah_ordered_whole += replay.counters(*sah_ordered, Rays::Occlusion);
+         sah_whole += replay.counters(*by_sah, Rays::Occlusion);
+         const double c_designed = replay.time(*designed_ordered), c_sah_ordered = replay.time(*sah_ordered, sah_ordered_whole),
+                      c_sah = replay.time(*by_sah, sah_whole);
          if (c_sah < c_designed && c_sah <= c_sah_ordered) return by_sah;
          if (c_sah_ordered < c_designed) return sah_ordered;
          return designed_ordered;
