@@ -38,16 +38,17 @@ struct DesignOptions {
 
 
 /// The root's centroid orders of the sweep (AxisOrders), sorted once for a design's several builds.
-std::optional<AxisOrders> root_orders(const Scene& s, const DesignOptions& o) {
+std::optional<AxisOrders> root_orders(const Scene& s, const DesignOptions& o, const PrimInfo& info) {
     if (o.sweep <= 0 || o.trust >= kNoTrust) return std::nullopt;
     std::vector<std::uint32_t> all(s.size());
     for (std::uint32_t i = 0; i < s.size(); ++i) all[i] = i;
-    return AxisOrders(all, PrimInfo(s));
+    return AxisOrders(all, info);
 }
 
-/// `root`: root_orders(s, o).
-BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions& o, const std::optional<AxisOrders>& root) {
-    PrimInfo info(s);
+/// `info`: the scene's PrimInfo; `root`: root_orders(s, o, info). (Both made once for a design's
+/// several builds.)
+BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions& o, const PrimInfo& info,
+                     const std::optional<AxisOrders>& root) {
     const RaySample& smp = in.sample;
     std::vector<RayInv> inv;
     inv.reserve(smp.size());
@@ -211,7 +212,7 @@ RaySample half_of(const RaySample& smp, std::size_t parity) {
 /// lattice's shadow rays 22.1% instead of 13.5%). Each count is designed on half the sample
 /// and priced on the other half; the cheapest there is kept. (Three more builds, each on a core
 /// of its own where there are cores.)
-int held_out_candidates(const Scene& s, const DesignInput& in, const DesignOptions& o,
+int held_out_candidates(const Scene& s, const DesignInput& in, const DesignOptions& o, const PrimInfo& info,
                         const std::optional<AxisOrders>& root) {
     static constexpr int kCounts[] = {8, 16, 32};
     DesignInput half;
@@ -223,7 +224,7 @@ int held_out_candidates(const Scene& s, const DesignInput& in, const DesignOptio
     tbb::parallel_for(std::size_t{0}, std::size(kCounts), [&](std::size_t i) {
         DesignOptions with = o;
         with.candidates = kCounts[i];
-        const Bvh h(s, "bvh-design", build_design(s, half, with, root), true);
+        const Bvh h(s, "bvh-design", build_design(s, half, with, info, root), true);
         cost[i] = replay.time(h);
     });
     std::size_t best = 0;  // a tie keeps the fewer
@@ -269,9 +270,10 @@ const Registration reg{
          o.candidates = p.is("candidates", "auto") ? 0 : static_cast<int>(p.integer("candidates"));
          o.trust = p.real("trust");
          const DesignInput in = draw_design_input(s, p);
-         const std::optional<AxisOrders> root = root_orders(s, o);
-         if (o.candidates == 0) o.candidates = o.trust < kNoTrust ? held_out_candidates(s, in, o, root) : 8;
-         BvhData designed_tree = build_design(s, in, o, root);
+         const PrimInfo info(s);
+         const std::optional<AxisOrders> root = root_orders(s, o, info);
+         if (o.candidates == 0) o.candidates = o.trust < kNoTrust ? held_out_candidates(s, in, o, info, root) : 8;
+         BvhData designed_tree = build_design(s, in, o, info, root);
          // bvh-sah's tree where the model predicts it cheaper on the sample than the designed
          // splits (as design/cheaper.hpp does for the other families).
          SahOptions usual;
