@@ -424,6 +424,10 @@ TEST(ModelSegments, ASampleOfAnotherSceneIsRefused) {
     for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
     auto h = build_hierarchy(b, "bvh-sah");
     EXPECT_THROW(predict_segments(h->model_tree(), b, smp, idx, ModelOptions{}), InputError);
+    for (auto via : {SegmentsPredictor::Via::Traversal, SegmentsPredictor::Via::ModelTree}) {
+        SegmentsPredictor predictor(*h, b, smp, 0, via);
+        EXPECT_THROW(predictor.predict(idx, ModelOptions{}), InputError);
+    }
 }
 
 // On rays the sample did not see, the prediction errs by the sample's noise only.

@@ -10,6 +10,7 @@
 
 #include "hierarchy/common/model_collector.hpp"
 #include "model_internal.hpp"
+#include "rtcost/error.hpp"
 #include "rtcost/sample.hpp"
 
 namespace rtcost {
@@ -355,10 +356,17 @@ Prediction replayed(const RayCounters& counters, std::size_t rays, const UnitCos
 Prediction SegmentsPredictor::predict(std::span<const std::uint32_t> rays, const ModelOptions& opt,
                                       const UnitCosts& costs) {
     // (Not Query::All: a BVH's traversal that never ends walks a polygon's edges only up to the
-    // nearest hit so far, where the model tree's probe walks them to the segment's end.)
-    if (via_ == Via::Traversal && opt.preset == Preset::Exact && opt.query != Query::All) {
-        for (std::uint32_t i : rays)
+    // nearest hit so far, where the model tree's probe walks them to the segment's end. Nor no
+    // rays at all: the model tree still charges each ray the root's test.)
+    if (via_ == Via::Traversal && opt.preset == Preset::Exact && opt.query != Query::All && !rays.empty()) {
+        for (std::uint32_t i : rays) {
             if (i >= sample_.size()) throw std::out_of_range("predict_segments: ray index beyond the sample");
+            for (const Crossing& c : sample_.crossings_of(i))  // as the model tree's probe refuses it
+                if (c.prim >= scene_.size())
+                    throw InputError("sample", 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
+                                                      std::to_string(scene_.size()) +
+                                                      " primitives): a sample of another scene?");
+        }
         RayCounters counters;
         try {
             if (h_.replay(sample_, rays, opt.query, counters)) return replayed(counters, rays.size(), costs);

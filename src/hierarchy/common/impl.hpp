@@ -167,8 +167,8 @@ bool HierarchyImpl<Derived>::replay(const RaySample& sample, std::span<const std
             if (!self().replay_is_model()) return false;
         Count counting{counters};
         for (std::uint32_t i : rays) {
+            const Ray& ray = sample.rays.rays.at(i);  // (a bad index throws before its crossings are read)
             const KnownTest test{sample.crossings_of(i), nullptr, *scene_};
-            const Ray& ray = sample.rays.rays.at(i);
             Hit hit;
             ++counters.rays;
             switch (query) {
