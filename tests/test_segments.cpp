@@ -247,8 +247,7 @@ TEST(ModelSegments, TheReachedTreePredictsWhatTheWholeTreePredicts) {
     Scene s = builtin_scene("balls", 3);
     auto ref = build_hierarchy(s, "bvh-sah");
     const RaySample smp = draw_sample_from(s, mixed_rays(s), 200, 3, *ref);
-    std::vector<std::uint32_t> idx(smp.size());
-    for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    const std::vector<std::uint32_t> idx = indices(smp.size());
     std::size_t pruned_trees = 0;
     for (const auto& [name, set] : modelled_variants(s)) {
         auto h = build_hierarchy(s, name, set);
@@ -295,8 +294,7 @@ TEST(ModelSegments, TheTraversalsReplayPredictsWhatTheModelTreePredicts) {
     Scene s = builtin_scene("balls", 3);
     auto ref = build_hierarchy(s, "bvh-sah");
     const RaySample smp = draw_sample_from(s, mixed_rays(s), 300, 5, *ref);
-    std::vector<std::uint32_t> idx(smp.size());
-    for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    const std::vector<std::uint32_t> idx = indices(smp.size());
     std::vector<Variant> variants = modelled_variants(s);
     variants.push_back({"grid", {"mailbox=1"}});
     variants.push_back({"kd-sah", {"mailbox=1"}});
@@ -347,8 +345,7 @@ TEST(ModelSegments, AReachedBvhHoldsWhatTheReplayEntersBeforeItsHit) {
     spec.size = "64x64";
     const RaySet cam = make_rays(s, spec);
     const RaySample smp = draw_sample_from(s, cam, 60, 5, *ref);
-    std::vector<std::uint32_t> idx(smp.size());
-    for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    const std::vector<std::uint32_t> idx = indices(smp.size());
     for (const char* name : {"bvh-sah", "bvh-median", "bvh-gs", "bvh-wide", "bvh-design"}) {
         auto h = build_hierarchy(s, name);
         const ModelTree whole = h->model_tree();
@@ -420,8 +417,7 @@ TEST(ModelSegments, ASampleOfAnotherSceneIsRefused) {
     Scene a = builtin_scene("balls", 3), b = builtin_scene("tetra", 2);
     auto ref = build_hierarchy(a, "bvh-sah");
     const RaySample smp = draw_sample_from(a, mixed_rays(a), 300, 1, *ref);
-    std::vector<std::uint32_t> idx(smp.size());
-    for (std::uint32_t i = 0; i < idx.size(); ++i) idx[i] = i;
+    const std::vector<std::uint32_t> idx = indices(smp.size());
     auto h = build_hierarchy(b, "bvh-sah");
     EXPECT_THROW(predict_segments(h->model_tree(), b, smp, idx, ModelOptions{}), InputError);
     for (auto via : {SegmentsPredictor::Via::Traversal, SegmentsPredictor::Via::ModelTree}) {

@@ -11,6 +11,7 @@
 #include "hierarchy/bvh-design/split_candidates.hpp"
 #include "rtcost/io.hpp"
 #include "rtcost/scene.hpp"
+#include "test_support.hpp"
 
 namespace rtcost::test {
 namespace {
@@ -38,8 +39,7 @@ void expect_orders_match(const AxisOrders& orders, const PrimInfo& info, std::ve
 TEST(SplitCandidates, AxisOrdersStaySortedAsNodesSplit) {
     const Scene s = builtin_scene("balls", 2);
     const PrimInfo info(s);
-    std::vector<std::uint32_t> ids(s.size());
-    for (std::uint32_t i = 0; i < s.size(); ++i) ids[i] = i;
+    std::vector<std::uint32_t> ids = indices(s.size());
     AxisOrders orders(ids, info);
     const auto n = static_cast<std::uint32_t>(ids.size());
     ASSERT_GT(n, 20u);
@@ -64,8 +64,7 @@ TEST(SplitCandidates, AxisOrdersStaySortedAsNodesSplit) {
 TEST(SplitCandidates, CheapestSweptCutIsTheFullSweepSahSplit) {
     const Scene s = builtin_scene("tetra", 4);
     const PrimInfo info(s);
-    std::vector<std::uint32_t> ids(s.size());
-    for (std::uint32_t i = 0; i < s.size(); ++i) ids[i] = i;
+    std::vector<std::uint32_t> ids = indices(s.size());
     const AxisOrders orders(ids, info);
     CutScratch scratch;
     std::vector<Cut> cuts;
@@ -140,8 +139,7 @@ void expect_same_cut(const Cut& got, const Cut& want, const std::string& what) {
 TEST(SplitCandidates, BinnedCutsAreTheCheapestBinBoundariesWithTheirSides) {
     const Scene s = builtin_scene("tetra", 4);
     const PrimInfo info(s);
-    std::vector<std::uint32_t> ids(s.size());
-    for (std::uint32_t i = 0; i < s.size(); ++i) ids[i] = i;
+    std::vector<std::uint32_t> ids = indices(s.size());
     const auto n = static_cast<std::uint32_t>(ids.size());
     ASSERT_GT(n, 100u);
     const int nbins = 16;
@@ -171,8 +169,7 @@ TEST(SplitCandidates, BinnedCutsAreTheCheapestBinBoundariesWithTheirSides) {
 TEST(SplitCandidates, EverySweptCutBoundsItsSides) {
     const Scene s = builtin_scene("balls", 2);
     const PrimInfo info(s);
-    std::vector<std::uint32_t> ids(s.size());
-    for (std::uint32_t i = 0; i < s.size(); ++i) ids[i] = i;
+    std::vector<std::uint32_t> ids = indices(s.size());
     const AxisOrders orders(ids, info);
     const auto n = static_cast<std::uint32_t>(ids.size());
     std::vector<Cut> want;

@@ -22,6 +22,13 @@
 
 namespace rtcost::test {
 
+/// 0, 1, ..., n - 1: every primitive of a scene, or every ray of a sample.
+inline std::vector<std::uint32_t> indices(std::size_t n) {
+    std::vector<std::uint32_t> v(n);
+    for (std::uint32_t i = 0; i < n; ++i) v[i] = i;
+    return v;
+}
+
 /// `../shared` beside the repository (RTCOST_SHARED overrides it).
 inline std::string shared_dir() {
     if (const char* env = std::getenv("RTCOST_SHARED")) return env;
