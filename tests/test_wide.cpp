@@ -1,4 +1,5 @@
 // bvh-wide: its lanes, its counts and its model tree, for both widths and both instruction sets.
+#include "rtcost/sample.hpp"
 #include "test_support.hpp"
 
 namespace rtcost::test {
@@ -129,6 +130,51 @@ TEST(BvhWide, TheSampledEstimatorReproducesTheTrainingRaysCounts) {
                 EXPECT_NEAR(p.cost.prim_tests(), m.prim_tests(), 1e-3 * m.prim_tests() + 1e-9) << what;
                 EXPECT_NEAR(p.cost.steps, m.steps, 1e-3 * m.steps + 1e-9) << what;
                 EXPECT_NEAR(p.cost.leaves, m.leaves, 1e-3 * m.leaves + 1e-9) << what;
+            }
+        }
+    }
+}
+
+TEST(BvhWide, ItsReplayOfASamplePredictsWhatItsModelTreePredicts) {
+    // The segments estimator replays a sample through the wide walk itself, each primitive
+    // answered from the ray's known crossings (a packed leaf's triangles one by one, in lane
+    // order): the model tree's prediction, without materialising the tree.
+    // balls: spheres and a ground polygon (scalar leaves); tetra: triangles (packed leaves).
+    for (const char* name : {"balls", "tetra"}) {
+        Scene s = builtin_scene(name, name[0] == 'b' ? 2 : 4);
+        auto ref = build_hierarchy(s, "bvh-sah");
+        RaySet set;
+        set.rays = camera_rays(s.camera, 40, 40);
+        std::vector<Ray> more = random_rays(s.bounds(), 1500, 23);
+        set.rays.insert(set.rays.end(), more.begin(), more.end());
+        set.kinds.assign(set.rays.size(), RayKind::Test);
+        const RaySample smp = draw_sample_from(s, set, 600, 3, *ref);
+        const std::vector<std::uint32_t> idx = indices(smp.size());
+        for (const auto& params : std::vector<std::vector<std::string>>{{"width=4"},
+                                                                        {"width=8"},
+                                                                        {"width=8", "tri_lanes=4"},
+                                                                        {"width=8", "max_prims=1", "c_trav=1"},
+                                                                        {"width=4", "simd=baseline"},
+                                                                        {"width=8", "simd=baseline", "any_order=nearest"}}) {
+            auto h = build_hierarchy(s, "bvh-wide", params);
+            for (Query q : {Query::Closest, Query::Any}) {
+                const std::string what = std::string(name) + " " + ::testing::PrintToString(params) + " query " +
+                                         std::to_string(static_cast<int>(q));
+                RayCounters replayed;
+                ASSERT_TRUE(h->replay(smp, idx, q, replayed)) << what;
+                EXPECT_EQ(replayed.rays, idx.size()) << what;
+                ModelOptions o;
+                o.query = q;
+                SegmentsPredictor traversal(*h, s, smp), tree(*h, s, smp, 0, SegmentsPredictor::Via::ModelTree);
+                const Prediction a = traversal.predict(idx, o), b = tree.predict(idx, o);
+                EXPECT_NE(a.note.find("the hierarchy's traversal"), std::string::npos) << what;
+                EXPECT_EQ(traversal.tree_seconds(), 0.0) << what << ": a replay materialises nothing";
+                ASSERT_GT(b.cost.prim_tests(), 0.0) << what;
+                EXPECT_NEAR(a.cost.box, b.cost.box, 1e-6 * b.cost.box) << what;
+                EXPECT_NEAR(a.cost.prim_tests(), b.cost.prim_tests(), 1e-6 * b.cost.prim_tests()) << what;
+                EXPECT_NEAR(a.cost.steps, b.cost.steps, 1e-6 * b.cost.steps) << what;
+                EXPECT_NEAR(a.cost.leaves, b.cost.leaves, 1e-6 * b.cost.leaves) << what;
+                EXPECT_NEAR(a.scalar, b.scalar, 1e-6 * b.scalar) << what;
             }
         }
     }

@@ -11,6 +11,7 @@
 
 #include <memory>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "../common/impl.hpp"
@@ -83,12 +84,15 @@ struct View {
 /// after everything nearer along the ray.
 enum AnyOrder : int { kAnyNearest = 0, kAnyLeaves = 1 };
 
-/// One traversal instantiation: closest, any or all, with or without counting.
+/// One traversal instantiation: closest, any or all, with or without counting. The last
+/// argument is null but in a replay, which answers every primitive test from the ray's known
+/// crossings (KnownTest) instead of intersecting.
 template <class C>
-using WalkFn = bool (*)(const View&, const Ray&, Hit&, C&);
+using WalkFn = bool (*)(const View&, const Ray&, Hit&, C&, const KnownTest*);
 struct Walks {
     WalkFn<NoCount> fast[3] = {};  ///< indexed by Query
     WalkFn<Count> counted[3] = {};
+    WalkFn<Count> replay[3] = {};  ///< counted, each primitive test a KnownTest
 };
 
 /// The traversals compiled for the baseline (SSE2 on x86-64, plain loops elsewhere; triangle
@@ -109,8 +113,16 @@ public:
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
-        if constexpr (C::enabled) return walks_.counted[static_cast<int>(Q)](view_, ray, hit, counting);
-        else return walks_.fast[static_cast<int>(Q)](view_, ray, hit, counting);
+        if constexpr (C::enabled) return walks_.counted[static_cast<int>(Q)](view_, ray, hit, counting, nullptr);
+        else return walks_.fast[static_cast<int>(Q)](view_, ray, hit, counting, nullptr);
+    }
+    /// The same walk with every primitive test answered from the ray's known crossings: what
+    /// Hierarchy::replay needs (the model tree's prediction, without materialising the tree).
+    /// Only KnownTest: a leaf's triangles are otherwise tested a pack at a time.
+    template <class C, Query Q, class PrimTest>
+        requires std::is_same_v<C, Count> && std::is_same_v<PrimTest, KnownTest>
+    bool trace_with(const Ray& ray, Hit& hit, C& counting, const PrimTest& test) const {
+        return walks_.replay[static_cast<int>(Q)](view_, ray, hit, counting, &test);
     }
 
 protected:
