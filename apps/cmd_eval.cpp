@@ -84,13 +84,17 @@ int cmd_eval(EvalArgs& a, const Common& common) {
         }
         progress.update(done);
     };
+    // The scene line goes out with the first row, not before: a run that stops on bad input
+    // (a sample file of another scene, say) prints its error and nothing on stdout.
     bool first = true;
-    if (!common.json)
-        fmt::print("scene {} ({} primitives: {})\n", scene.name, scene.size(), kind_summary(scene));
+    auto scene_line = [&] {
+        if (first) fmt::print("scene {} ({} primitives: {})\n", scene.name, scene.size(), kind_summary(scene));
+    };
     opt.on_row = [&](const EvalRow& row) {
         progress.finish();
         shown_step.clear();
         if (common.json) return;
+        scene_line();
         if (first) std::cout << eval_columns();
         first = false;
         std::cout << eval_row(row) << std::flush;
@@ -101,6 +105,7 @@ int cmd_eval(EvalArgs& a, const Common& common) {
         std::cout << to_json(r, a.by_depth).dump(2) << "\n";
         return 0;
     }
+    scene_line();
     std::cout << "\n" << eval_header(r) << eval_summary(r, a.by_depth);
     return 0;
 }

@@ -86,6 +86,20 @@ TEST(ReliabilityCli, OutputsOntoDevicesLinksAndDirectories) {
     EXPECT_BAD_INPUT(rtcost("calibrate builtin:tetra:2 -H bvh-sah -o " + d), d + ": is a directory");
 }
 
+TEST(ReliabilityCli, ASampleOfAnotherSceneStopsEvalBeforeAnyOutput) {
+    const std::string smp = (dir() / "tetra.sample").string();
+    ASSERT_EQ(rtcost("sample builtin:tetra:2 --rays lines --population 2000 --count 64 -q -o " + smp).code, 0);
+    // builtin:balls:1 has 11 primitives, tetra:2 16: only the fingerprint tells them apart one
+    // way round; the ids do the other.
+    for (const char* other : {"builtin:balls:1", "builtin:tetra:3"}) {
+        const CliResult r =
+            rtcost(std::string("eval ") + other + " -H bvh-sah --rays lines --count 2000 --estimator segments --sample-file " + smp);
+        EXPECT_BAD_INPUT(r, smp + ": the sample was drawn on another scene");
+        EXPECT_EQ(r.out, "") << other << ": stdout before the error";
+    }
+    EXPECT_EQ(rtcost("eval builtin:tetra:2 -H bvh-sah --rays lines --count 2000 --estimator segments -q --sample-file " + smp).code, 0);
+}
+
 TEST(ReliabilityCli, PlyWithoutEndHeaderEndsWithAnError) {
     const fs::path p = file("noend.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\n"
                                          "property float y\nproperty float z\n0 0 0\n1 0 0\n0 1 0\n");

@@ -146,6 +146,8 @@ TEST(RaySample, FileRoundTripsAndBadFilesAreRefused) {
     EXPECT_EQ(b.distribution, a.distribution);
     EXPECT_EQ(b.population, a.population);
     EXPECT_EQ(b.seed, a.seed);
+    EXPECT_EQ(a.scene, s.fingerprint());
+    EXPECT_EQ(b.scene, a.scene);
     ASSERT_EQ(b.crossings.size(), a.crossings.size());
     for (std::size_t i = 0; i < a.size(); ++i) {
         EXPECT_EQ(b.rays.rays[i].d, a.rays.rays[i].d);
@@ -157,18 +159,65 @@ TEST(RaySample, FileRoundTripsAndBadFilesAreRefused) {
         EXPECT_EQ(b.crossings[i].prim, a.crossings[i].prim);
         EXPECT_EQ(b.crossings[i].t, a.crossings[i].t);
     }
-    // Truncated, and not a sample at all.
     std::string bytes;
     {
         std::ifstream in(path, std::ios::binary);
         bytes.assign(std::istreambuf_iterator<char>(in), {});
     }
+    // A version-1 file (no scene fingerprint after the counts) is read, its scene unknown.
+    {
+        std::string v1 = bytes;
+        ASSERT_EQ(v1[8], 2);
+        v1[8] = 1;
+        v1.erase(8 + 4 + 4 + 4 * 8, 8);
+        std::ofstream(path, std::ios::binary).write(v1.data(), static_cast<std::streamsize>(v1.size()));
+        const RaySample c = read_sample(path);
+        EXPECT_EQ(c.scene, 0u);
+        ASSERT_EQ(c.size(), a.size());
+        EXPECT_EQ(c.crossings.size(), a.crossings.size());
+        std::string v3 = bytes;
+        v3[8] = 3;
+        std::ofstream(path, std::ios::binary).write(v3.data(), static_cast<std::streamsize>(v3.size()));
+        EXPECT_THROW(read_sample(path), InputError);
+    }
+    // Truncated, and not a sample at all.
     for (std::size_t cut : {std::size_t(4), std::size_t(40), bytes.size() - 3}) {
         std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(cut));
         EXPECT_THROW(read_sample(path), InputError) << "cut at " << cut;
     }
     std::ofstream(path, std::ios::binary) << "not a sample file at all, just text";
     EXPECT_THROW(read_sample(path), InputError);
+    std::filesystem::remove(path);
+}
+
+TEST(RaySample, AFileDrawnOnAnotherSceneIsRefusedByEval) {
+    // Samples of two scenes whose primitive ids overlap (a sample's ids all exist in the other
+    // scene): the fingerprint, not the ids, tells them apart. The same scene built twice agrees.
+    Scene balls = builtin_scene("balls", 1), tetra = builtin_scene("tetra", 2);
+    ASSERT_LT(balls.size(), tetra.size());
+    EXPECT_EQ(builtin_scene("balls", 1).fingerprint(), balls.fingerprint());
+    EXPECT_NE(balls.fingerprint(), tetra.fingerprint());
+    EXPECT_NE(builtin_scene("balls", 2).fingerprint(), balls.fingerprint());
+    RaySpec spec;
+    spec.name = "lines";
+    spec.count = 2000;
+    auto ref = build_hierarchy(balls, "bvh-sah");
+    const RaySample smp = draw_sample_from(balls, make_rays(balls, spec), 64, 1, *ref);
+    const std::string path = temp_path("balls.sample");
+    write_sample(path, smp);
+    EvalOptions opt;
+    opt.hierarchies = {HierarchyRequest{"bvh-sah", {}}};
+    opt.estimators = {Estimator::Segments};
+    opt.sample_file = path;
+    opt.repeat = 1;
+    try {
+        evaluate(tetra, spec, opt);
+        ADD_FAILURE() << "a sample of another scene was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("drawn on another scene"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+    }
+    EXPECT_EQ(evaluate(balls, spec, opt).rows.size(), 1u);
     std::filesystem::remove(path);
 }
 

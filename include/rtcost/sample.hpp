@@ -28,6 +28,9 @@ struct RaySample {
     std::string distribution;            ///< what was sampled, e.g. "spd 512x512 seed 1"
     std::uint64_t seed = 0;
     std::size_t population = 0;          ///< rays of the whole distribution the sample was drawn from
+    /// Scene::fingerprint() of the scene it was drawn on (set by find_ends); 0: unknown (a
+    /// version-1 sample file).
+    std::uint64_t scene = 0;
 
     std::size_t size() const { return rays.rays.size(); }
     std::span<const Crossing> crossings_of(std::size_t i) const {

@@ -107,6 +107,10 @@ public:
     float prim_area(std::uint32_t id) const;
     /// Every primitive's bounds, area and kind, by id, as of the last finalize() (empty before).
     const std::vector<PrimSummary>& summaries() const { return summaries_; }
+    /// A hash of every primitive's kind, bounds and area as of the last finalize(): what a ray
+    /// sample records of the scene it was drawn on, so that one drawn on another scene is told
+    /// apart (RaySample::scene). Not a cryptographic hash.
+    std::uint64_t fingerprint() const { return fingerprint_; }
     PrimKind kind(std::uint32_t id) const { return prims[id].kind; }
     /// Edges a test of primitive `id` walks (RayCounters::polygon_edges): a polygon of more than
     /// three vertices, by its crossing test, each of its edges; no other primitive any. With
@@ -157,6 +161,7 @@ private:
     Box3 bounds_;
     std::vector<PrimSummary> summaries_;
     std::uint32_t max_polygon_vertices_ = 0;
+    std::uint64_t fingerprint_ = 0;
 };
 
 }  // namespace rtcost

@@ -14,8 +14,9 @@ namespace rtcost {
 namespace {
 
 constexpr char kMagic[8] = {'R', 'T', 'C', 'S', 'A', 'M', 'P', 'L'};
-constexpr std::uint32_t kVersion = 1;
-constexpr std::size_t kHeader = 8 + 4 + 4 + 4 * 8 + 4;  // magic, version, reserved, 4 counts, text length
+// Version 2 added the scene's fingerprint after the counts; version 1 files are still read.
+constexpr std::uint32_t kVersion = 2;
+constexpr std::size_t kHeader = 8 + 4 + 4 + 5 * 8 + 4;  // magic, version, reserved, 4 counts, fingerprint, text length
 constexpr std::size_t kRayRecord = 8 * 4 + 1 + 1 + 2 + 4;
 constexpr std::size_t kCrossingRecord = 8;
 
@@ -36,6 +37,7 @@ void write_sample(const std::string& path, const RaySample& s) {
     put(out, std::uint64_t{s.population});
     put(out, std::uint64_t{s.size()});
     put(out, std::uint64_t{s.crossings.size()});
+    put(out, std::uint64_t{s.scene});
     put(out, static_cast<std::uint32_t>(s.distribution.size()));
     out += s.distribution;
     for (std::size_t i = 0; i < s.size(); ++i) {
@@ -71,14 +73,16 @@ RaySample read_sample(const std::string& path) {
     if (std::memcmp(b.data(), kMagic, 8) != 0) throw InputError(path, 0, "not a sample file (written by rtcost sample)");
     at = 8;
     std::uint32_t version = 0, reserved = 0, text = 0;
-    std::uint64_t seed = 0, population = 0, rays = 0, crossings = 0;
+    std::uint64_t seed = 0, population = 0, rays = 0, crossings = 0, scene = 0;
     get(version, "header");
-    if (version != kVersion) throw InputError(path, 0, "sample file version " + std::to_string(version) + " (this rtcost reads 1)");
+    if (version != 1 && version != kVersion)
+        throw InputError(path, 0, "sample file version " + std::to_string(version) + " (this rtcost reads 1 and 2)");
     get(reserved, "header");
     get(seed, "header");
     get(population, "header");
     get(rays, "header");
     get(crossings, "header");
+    if (version >= 2) get(scene, "header");
     get(text, "header");
     // The counts must fit the file before anything is allocated for them.
     const std::size_t left = b.size() - at;
@@ -88,6 +92,7 @@ RaySample read_sample(const std::string& path) {
     RaySample s;
     s.seed = seed;
     s.population = population;
+    s.scene = scene;
     s.distribution.assign(b.data() + at, text);
     at += text;
     s.rays.described = s.distribution + " (sample)";

@@ -347,6 +347,10 @@ std::optional<RaySample> take_sample(const Scene& scene, RaySet& test, const Eva
         const auto start = std::chrono::steady_clock::now();
         if (!opt.sample_file.empty()) {
             sample = read_sample(opt.sample_file);
+            if (sample->scene != 0 && sample->scene != scene.fingerprint())
+                throw InputError(opt.sample_file, 0,
+                                 "the sample was drawn on another scene (its primitives differ from " + scene.name +
+                                     "'s)");
             if (sample->distribution != test.described || sample->population != test.rays.size())
                 throw InputError(opt.sample_file, 0,
                                  "the sample was drawn from '" + sample->distribution + "' (" +

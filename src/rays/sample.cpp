@@ -252,6 +252,7 @@ RaySet rays_outside_sample(const RaySet& all, std::size_t count, std::uint64_t s
 }
 
 void find_ends(RaySample& s, const Hierarchy& reference) {
+    s.scene = reference.scene().fingerprint();
     const std::size_t n = s.rays.rays.size();
     std::vector<std::vector<Crossing>> per(n);
     tbb::parallel_for(std::size_t(0), n, [&](std::size_t i) {

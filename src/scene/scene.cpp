@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <cmath>
 
 #include <fmt/format.h>
@@ -199,6 +200,22 @@ void Scene::finalize() {
         bounds_.extend(sums[id].bounds);
     }
     summaries_ = std::move(sums);
+    // Every value's bits mixed in turn (splitmix64's finaliser): order and value both count.
+    auto mix = [](std::uint64_t h, std::uint64_t v) {
+        h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
+        h ^= h >> 30;
+        h *= 0xbf58476d1ce4e5b9ull;
+        h ^= h >> 27;
+        h *= 0x94d049bb133111ebull;
+        return h ^ (h >> 31);
+    };
+    fingerprint_ = mix(0, summaries_.size());
+    for (const PrimSummary& p : summaries_) {
+        const float f[7] = {p.bounds.lo.x, p.bounds.lo.y, p.bounds.lo.z, p.bounds.hi.x, p.bounds.hi.y, p.bounds.hi.z, p.area};
+        std::uint64_t h = static_cast<std::uint64_t>(p.kind);
+        for (float x : f) h = mix(h, std::bit_cast<std::uint32_t>(x));
+        fingerprint_ = mix(fingerprint_, h);
+    }
     max_polygon_vertices_ = 0;
     for (const Polygon& p : polygons) max_polygon_vertices_ = std::max(max_polygon_vertices_, p.count);
     if (materials.empty()) materials.push_back(Material{});
