@@ -384,6 +384,31 @@ TEST(ModelSegments, TheTraversalsReplayPredictsWhatTheModelTreePredicts) {
     EXPECT_GE(modelled, 3u * 4);   // the mailboxed three, rc5d; every hierarchy's All
 }
 
+// A 5D tree has few nodes and many references (each beam lists every primitive it may meet):
+// whether to materialise it whole is decided by both, so a small sample copies only the beams
+// its rays fall in, and predicts what the whole tree predicts.
+TEST(ModelSegments, A5DTreeOfManyReferencesIsMaterialisedOnlyWhereTheSampleReaches) {
+    Scene s = builtin_scene("balls", 3);
+    auto ref = build_hierarchy(s, "bvh-sah");
+    RaySpec spec;
+    spec.size = "32x32";
+    const RaySample smp = draw_sample_from(s, make_rays(s, spec), 60, 5, *ref);
+    const std::vector<std::uint32_t> idx = indices(smp.size());
+    auto h = build_hierarchy(s, "rc5d", {"build=eager", "max_depth=6"});
+    const StructureStats st = h->structure();
+    // Few enough nodes to be taken whole by nodes alone; references far beyond.
+    ASSERT_LE(st.interior + st.leaves, SegmentsPredictor::kWholeItemsPerRay * smp.size() / 2);
+    ASSERT_GT(st.references, 10 * SegmentsPredictor::kWholeItemsPerRay * smp.size());
+    const ModelTree whole = h->model_tree();
+    SegmentsPredictor predictor(*h, s, smp);
+    ModelOptions o;
+    const Prediction a = predictor.predict(idx, o), b = predict_segments(whole, s, smp, idx, o);
+    EXPECT_LT(predictor.tree().prims.size(), whole.prims.size() / 4);
+    EXPECT_DOUBLE_EQ(a.scalar, b.scalar);
+    EXPECT_DOUBLE_EQ(a.cost.classify, b.cost.classify);
+    EXPECT_DOUBLE_EQ(a.cost.prim_tests(), b.cost.prim_tests());
+}
+
 // Where a BVH is far larger than its sample, only the part the sample reaches is materialised,
 // and that part holds every node a closest-hit replay enters: the overlapping children searched
 // before the hit is found, beyond the ray's end. Camera rays of a scene of many small spheres.

@@ -222,10 +222,11 @@ public:
         /// Always the part of the model tree the sample reaches, materialised.
         ModelTree,
     };
-    /// `h`, `scene` and `sample` must outlive the predictor. `nodes`: the hierarchy's nodes when
-    /// the caller has its structure() already (0: counted here, a walk over the whole
-    /// hierarchy). The model tree is materialised when a prediction first needs it.
-    SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample, std::size_t nodes = 0,
+    /// `h`, `scene` and `sample` must outlive the predictor. `size`: the hierarchy's nodes and
+    /// references (StructureStats interior + leaves + references) when the caller has its
+    /// structure() already (0: counted here, a walk over the whole hierarchy). The model tree
+    /// is materialised when a prediction first needs it.
+    SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample, std::size_t size = 0,
                       Via via = Via::Traversal);
     /// predict_segments over the sample's rays `rays`.
     Prediction predict(std::span<const std::uint32_t> rays, const ModelOptions& opt, const UnitCosts& costs = {});
@@ -234,8 +235,9 @@ public:
     /// The tree predictions through the model tree are made on (pruned until a replay needed the
     /// whole one), materialised if no prediction has needed it yet.
     const ModelTree& tree();
-    /// A hierarchy of at most this many nodes per sample ray is materialised whole.
-    static constexpr std::size_t kWholeNodesPerRay = 16;
+    /// A hierarchy of at most this many nodes and references per sample ray is materialised
+    /// whole. References count: a 5D tree of a few thousand nodes may hold millions of them.
+    static constexpr std::size_t kWholeItemsPerRay = 32;
 
 private:
     void materialise();
@@ -243,7 +245,7 @@ private:
     const Hierarchy& h_;
     const Scene& scene_;
     const RaySample& sample_;
-    std::size_t nodes_;
+    std::size_t size_;
     Via via_;
     ModelTree tree_;
     bool materialised_ = false;

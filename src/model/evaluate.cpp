@@ -232,7 +232,7 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
             const double tree_seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - tree_start).count();
             std::optional<SegmentsPredictor> segments;
-            const std::size_t nodes = row.structure.interior + row.structure.leaves;
+            const std::size_t nodes = row.structure.interior + row.structure.leaves + row.structure.references;
             if (sample && wants(opt, Estimator::Segments)) segments.emplace(*h, scene, *sample, nodes);
             // Over the visibility sample. A lazy hierarchy exists only where rays went: the one
             // predicted is a fresh build grown by the sample's own rays (no ray of the user's),

@@ -309,20 +309,22 @@ ModelTree reached_model_tree(const Hierarchy& h, const Scene& scene, const RaySa
 }  // namespace
 
 SegmentsPredictor::SegmentsPredictor(const Hierarchy& h, const Scene& scene, const RaySample& sample,
-                                     std::size_t nodes, Via via)
-    : h_(h), scene_(scene), sample_(sample), nodes_(nodes), via_(via) {}
+                                     std::size_t size, Via via)
+    : h_(h), scene_(scene), sample_(sample), size_(size), via_(via) {}
 
 void SegmentsPredictor::materialise() {
     if (materialised_) return;
     const auto start = std::chrono::steady_clock::now();
-    // A tree of a few nodes per sample ray (a BVH) is reached nearly everywhere: finding where
-    // the segments reach would repeat the replay's clipping for nothing, so it is taken whole.
-    std::size_t nodes = nodes_;
-    if (nodes == 0) {
+    // A tree of a few nodes and references per sample ray (a BVH) is reached nearly everywhere:
+    // finding where the segments reach would repeat the replay's clipping for nothing, so it is
+    // taken whole. (Not by nodes alone: a 5D tree's few thousand nodes may hold millions of
+    // references, all copied by a whole tree.)
+    std::size_t size = size_;
+    if (size == 0) {
         const StructureStats st = h_.structure();
-        nodes = st.interior + st.leaves;
+        size = st.interior + st.leaves + st.references;
     }
-    whole_ = nodes <= kWholeNodesPerRay * std::max<std::size_t>(sample_.size(), 1);
+    whole_ = size <= kWholeItemsPerRay * std::max<std::size_t>(sample_.size(), 1);
     tree_ = whole_ ? h_.model_tree() : reached_model_tree(h_, scene_, sample_);
     materialised_ = true;
     tree_seconds_ += std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
