@@ -380,8 +380,8 @@ TEST(ModelSegments, TheTraversalsReplayPredictsWhatTheModelTreePredicts) {
             EXPECT_EQ(traversal.tree_seconds() == 0, by_traversal) << what << ": a replay materialises nothing";
         }
     }
-    EXPECT_GE(replayed, 2u * 11);  // the BVHs (bvh-wide too), kd-trees, grids, octrees and BSP trees
-    EXPECT_GE(modelled, 3u * 4);   // the mailboxed three, rc5d; every hierarchy's All
+    EXPECT_GE(replayed, 2u * 12);  // the BVHs (bvh-wide too), kd-trees, grids, octrees, BSP trees and rc5d
+    EXPECT_GE(modelled, 3u * 3);   // the mailboxed three; every hierarchy's All
 }
 
 // A 5D tree has few nodes and many references (each beam lists every primitive it may meet):
@@ -400,7 +400,7 @@ TEST(ModelSegments, A5DTreeOfManyReferencesIsMaterialisedOnlyWhereTheSampleReach
     ASSERT_LE(st.interior + st.leaves, SegmentsPredictor::kWholeItemsPerRay * smp.size() / 2);
     ASSERT_GT(st.references, 10 * SegmentsPredictor::kWholeItemsPerRay * smp.size());
     const ModelTree whole = h->model_tree();
-    SegmentsPredictor predictor(*h, s, smp);
+    SegmentsPredictor predictor(*h, s, smp, 0, SegmentsPredictor::Via::ModelTree);
     ModelOptions o;
     const Prediction a = predictor.predict(idx, o), b = predict_segments(whole, s, smp, idx, o);
     EXPECT_LT(predictor.tree().prims.size(), whole.prims.size() / 4);

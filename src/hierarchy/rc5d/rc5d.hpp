@@ -102,6 +102,13 @@ public:
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
+        return trace_with<C, Q>(ray, hit, counting, RealPrimTest{*scene_});
+    }
+
+    /// The traversal with the primitive test supplied by the caller: RealPrimTest in a trace,
+    /// CrossingCollector for Hierarchy::crossings, KnownTest for Hierarchy::replay.
+    template <class C, Query Q, class PrimTest>
+    bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {
         counting.box();
         if (empty_) return false;
         const RayInv ri(ray);
@@ -148,7 +155,7 @@ public:
         bool found = false;
         if constexpr (Q == Query::All) {
             for (std::uint32_t i = 0; i < count; ++i)
-                if (test_prim(*scene_, refs[i], ray, hit, counting)) found = true;
+                if (test(refs[i], ray, hit, counting)) found = true;
             return found;
         } else {
             // Candidate i can only be hit at a dominant coordinate (forward, s * p_k) at or beyond
@@ -165,7 +172,7 @@ public:
             for (std::uint32_t i = 0; i < count; ++i) {
                 const std::uint32_t id = refs[i];
                 if (static_cast<double>(near[id]) > stop) break;
-                if (test_prim(*scene_, id, ray, hit, counting)) {
+                if (test(id, ray, hit, counting)) {
                     found = true;
                     if constexpr (Q == Query::Any) return true;
                     stop = stop_at(hit.t < ray.tmax ? hit.t : ray.tmax);
