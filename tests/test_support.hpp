@@ -29,6 +29,18 @@ inline std::vector<std::uint32_t> indices(std::size_t n) {
     return v;
 }
 
+/// Camera rays of a 40 x 40 image and 2,500 random rays through the scene's box, as one set of
+/// test rays: the segments estimator's tests draw their samples from it.
+inline RaySet mixed_rays(const Scene& s) {
+    RaySet set;
+    set.rays = camera_rays(s.camera, 40, 40);
+    std::vector<Ray> more = random_rays(s.bounds(), 2500, 31);
+    set.rays.insert(set.rays.end(), more.begin(), more.end());
+    set.kinds.assign(set.rays.size(), RayKind::Test);
+    set.described = "camera 40x40 and random 2500";
+    return set;
+}
+
 /// `../shared` beside the repository (RTCOST_SHARED overrides it).
 inline std::string shared_dir() {
     if (const char* env = std::getenv("RTCOST_SHARED")) return env;
