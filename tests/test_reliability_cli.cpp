@@ -89,8 +89,9 @@ TEST(ReliabilityCli, OutputsOntoDevicesLinksAndDirectories) {
 TEST(ReliabilityCli, ASampleOfAnotherSceneStopsEvalBeforeAnyOutput) {
     const std::string smp = (dir() / "tetra.sample").string();
     ASSERT_EQ(rtcost("sample builtin:tetra:2 --rays lines --population 2000 --count 64 -q -o " + smp).code, 0);
-    // builtin:balls:1 has 11 primitives, tetra:2 16: only the fingerprint tells them apart one
-    // way round; the ids do the other.
+    // tetra:3 holds every primitive id of tetra:2's sample (only the fingerprint tells them
+    // apart); balls:1 holds fewer primitives than the sample's ids. Either way the fingerprint
+    // is checked first.
     for (const char* other : {"builtin:balls:1", "builtin:tetra:3"}) {
         const CliResult r =
             rtcost(std::string("eval ") + other + " -H bvh-sah --rays lines --count 2000 --estimator segments --sample-file " + smp);

@@ -232,8 +232,8 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
             const double tree_seconds =
                 std::chrono::duration<double>(std::chrono::steady_clock::now() - tree_start).count();
             std::optional<SegmentsPredictor> segments;
-            const std::size_t nodes = row.structure.interior + row.structure.leaves + row.structure.references;
-            if (sample && wants(opt, Estimator::Segments)) segments.emplace(*h, scene, *sample, nodes);
+            const std::size_t size = row.structure.interior + row.structure.leaves + row.structure.references;
+            if (sample && wants(opt, Estimator::Segments)) segments.emplace(*h, scene, *sample, size);
             // Over the visibility sample. A lazy hierarchy exists only where rays went: the one
             // predicted is a fresh build grown by the sample's own rays (no ray of the user's),
             // so that the measured one stays the tree its test rays grew.
@@ -246,7 +246,7 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                 trace_rays(*grown, visibility->rays.rays);
                 grow_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - grow_start).count();
             }
-            if (visibility) seen.emplace(grown ? *grown : *h, scene, *visibility, grown ? 0 : nodes);
+            if (visibility) seen.emplace(grown ? *grown : *h, scene, *visibility, grown ? 0 : size);
             // (The segments predictor materialises a tree, when it needs one, within the
             // prediction that needed it, which that prediction's time holds.)
             for (Estimator est : opt.estimators) {

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "rtcost/error.hpp"
+#include "util/rng.hpp"
 #include <numbers>
 
 namespace rtcost {
@@ -200,15 +201,8 @@ void Scene::finalize() {
         bounds_.extend(sums[id].bounds);
     }
     summaries_ = std::move(sums);
-    // Every value's bits mixed in turn (splitmix64's finaliser): order and value both count.
-    auto mix = [](std::uint64_t h, std::uint64_t v) {
-        h ^= v + 0x9e3779b97f4a7c15ull + (h << 6) + (h >> 2);
-        h ^= h >> 30;
-        h *= 0xbf58476d1ce4e5b9ull;
-        h ^= h >> 27;
-        h *= 0x94d049bb133111ebull;
-        return h ^ (h >> 31);
-    };
+    // Every value's bits mixed in turn (mix64, a bijection): order and value both count.
+    auto mix = [](std::uint64_t h, std::uint64_t v) { return mix64(h ^ v); };
     fingerprint_ = mix(0, summaries_.size());
     for (const PrimSummary& p : summaries_) {
         const float f[7] = {p.bounds.lo.x, p.bounds.lo.y, p.bounds.lo.z, p.bounds.hi.x, p.bounds.hi.y, p.bounds.hi.z, p.area};
