@@ -165,7 +165,7 @@ def main():
                 "tracing every ray of the distribution through it. The prediction replays the sample through "
                 "the hierarchy's own traversal, each primitive test answered from the ray's known crossings "
                 "(`Hierarchy::replay`: the model tree's prediction, without materialising the tree), where "
-                "the traversal is the model's (not with mailboxes, nor bvh-design's order bytes; bvh-wide's and "
+                "the traversal is the model's (not with mailboxes; bvh-design's order bytes since 2026-12-05, now in its model tree; bvh-wide's and "
                 "rc5d's since 2026-12-05: a wide node's met children sorted as the model sorts them and a leaf's "
                 "triangles answered one by one in pack order, a 5D beam's candidates in their order with its stop "
                 "rule); elsewhere it materialises the part of the model tree the sample reaches, "

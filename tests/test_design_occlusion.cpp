@@ -1,6 +1,7 @@
 // bvh-design's occlusion order (occlusion=sample): an order per node and direction from the sample,
 // on the designed tree or on bvh-sah's, and of those and bvh-sah walked front to back the one its
-// own walk of the sample prices cheapest.
+// own walk of the sample prices cheapest; and the model's estimators taking that order from the
+// model tree (ModelNode::any_order).
 #include <gtest/gtest.h>
 
 #include "rtcost/design.hpp"
@@ -50,6 +51,72 @@ TEST(DesignOcclusion, TheOrderChosenCountsNoMoreOnItsSampleThanFrontToBack) {
         }
     }
     EXPECT_GE(fewer, 2);
+}
+
+// A node's own order (ModelNode::any_order) is modelled as that order stored: a tree whose binary
+// nodes all enter their second child first predicts, for every occlusion ray and for the sample,
+// what the same tree with each node's two children swapped predicts when walked in stored order.
+TEST(DesignOcclusion, ANodesOwnOrderIsModelledAsThatOrderStored) {
+    const Scene s = load_scene("builtin:balls:3");
+    RaySpec spec;
+    spec.name = "shadow";
+    spec.size = "32x32";
+    auto ref = build_hierarchy(s, "bvh-sah");
+    const ModelTree plain = ref->model_tree();
+    ModelTree second = plain, swapped = plain;
+    std::size_t binary = 0;
+    for (std::size_t i = 0; i < plain.nodes.size(); ++i) {
+        const ModelNode& m = plain.nodes[i];
+        if (m.leaf || m.count != 2) continue;
+        ++binary;
+        second.nodes[i].any_order = kAnyOrderSet | 0b1100;  // second child first, either way
+        std::swap(swapped.nodes[m.first], swapped.nodes[m.first + 1]);  // the subtrees move with them
+    }
+    ASSERT_GT(binary, 100u);
+    swapped.cull = false;  // stored order (an any-hit query cuts nothing by distance either way)
+    const RaySample smp = draw_sample(s, spec, 512, 7, *ref);
+    ModelOptions any;
+    any.query = Query::Any;
+    const auto idx = indices(smp.size());
+    const Prediction a = predict_segments(second, s, smp, idx, any), b = predict_segments(swapped, s, smp, idx, any),
+                     nearest = predict_segments(plain, s, smp, idx, any);
+    EXPECT_NEAR(a.scalar, b.scalar, 1e-9 * b.scalar);
+    EXPECT_NEAR(a.cost.box, b.cost.box, 1e-9 * b.cost.box);
+    EXPECT_NEAR(a.cost.prim_tests(), b.cost.prim_tests(), 1e-9 * b.cost.prim_tests());
+    EXPECT_GT(std::fabs(a.scalar - nearest.scalar), 1e-3 * nearest.scalar);  // the order matters here
+    const RayCostModel ra(second, s, smp, idx, any), rb(swapped, s, smp, idx, any);
+    for (std::size_t i = 0; i < smp.size(); ++i) {
+        const CostVector x = ra.predict(smp.rays.rays[i]), y = rb.predict(smp.rays.rays[i]);
+        ASSERT_NEAR(x.box, y.box, 1e-9 * (1 + y.box)) << "ray " << i;
+        ASSERT_NEAR(x.prim_tests(), y.prim_tests(), 1e-9 * (1 + y.prim_tests())) << "ray " << i;
+    }
+}
+
+// Without rays (isotropic lines, half going each way along any axis) the prediction is linear in
+// the share of lines a node enters first child first: a root entered first child first by every
+// line and one entered second child first by every line average to the random order of a root
+// without its own, as does a root whose order turns with the direction's sign.
+TEST(DesignOcclusion, TheGeometricModelTakesTheNodesOwnOrderAsTheShareOfLinesItOrders) {
+    const Scene s = load_scene("builtin:balls:3");
+    const ModelTree plain = build_hierarchy(s, "bvh-sah")->model_tree();
+    ASSERT_TRUE(!plain.nodes[0].leaf && plain.nodes[0].count == 2);
+    auto with_order = [&](std::uint8_t bits) {
+        ModelTree t = plain;
+        t.nodes[0].any_order = kAnyOrderSet | bits;
+        return t;
+    };
+    ModelOptions any;
+    any.query = Query::Any;
+    const double none = predict_geometric(plain, s, any).scalar;
+    const double first = predict_geometric(with_order(0), s, any).scalar;            // first child first
+    const double second = predict_geometric(with_order(0b1100), s, any).scalar;      // second child first
+    const double by_sign = predict_geometric(with_order(0b0100 | 1), s, any).scalar;  // half each way
+    EXPECT_GT(std::fabs(first - second), 1e-3 * none);
+    EXPECT_NEAR(first + second, 2 * none, 1e-9 * none);
+    EXPECT_NEAR(by_sign, none, 1e-9 * none);
+    // Closest-hit queries keep the nearest child first.
+    ModelOptions closest;
+    EXPECT_DOUBLE_EQ(predict_geometric(with_order(0), s, closest).scalar, predict_geometric(plain, s, closest).scalar);
 }
 
 }  // namespace

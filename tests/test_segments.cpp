@@ -21,6 +21,10 @@ std::vector<Variant> modelled_variants(const Scene& s) {
         out.push_back({info->name, set});
     }
     out.push_back({"bvh-sah", {"order=none"}});
+    // bvh-design's own order for occlusion rays (ModelNode::any_order), for each kind of ray
+    // its sample holds.
+    out.push_back({"bvh-design", {"rays=shadow", "size=24x24", "sample=256", "occlusion=sample"}});
+    out.push_back({"bvh-design", {"rays=spd", "size=24x24", "sample=256", "occlusion=sample"}});
     out.push_back({"bsp", {"traversal=recursive"}});
     out.push_back({"octree", {"traversal=recursive", "max_prims=2"}});
     return out;
@@ -125,8 +129,8 @@ TEST(ModelSegments, TheReachedTreePredictsWhatTheWholeTreePredicts) {
 // The default predictor replays the sample through each hierarchy's own traversal where it
 // can, instead of materialising the model tree: the same prediction (kd-trees within rounding,
 // their traversal widening each plane crossing by a few ulps) for every hierarchy and query,
-// and the model tree's own where the traversal is not the model's (mailboxes, bvh-design's
-// order bytes) or the query never ends (Query::All: a BVH's traversal walks a polygon's
+// and the model tree's own where the traversal is not the model's (mailboxes) or the query
+// never ends (Query::All: a BVH's traversal walks a polygon's
 // edges up to the nearest hit so far, its model tree to the segment's end).
 TEST(ModelSegments, TheTraversalsReplayPredictsWhatTheModelTreePredicts) {
     Scene s = builtin_scene("balls", 3);

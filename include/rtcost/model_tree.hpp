@@ -36,7 +36,21 @@ struct ModelNode {
     /// 5D ray classification: the children split one of the five dimensions at `split`:
     /// `beam_dim` 0..2 origin, 3 u, 4 v (the node's directions are its ModelBeam).
     std::int8_t beam_dim = -1;
+    /// A two-child node whose any-hit (occlusion) query enters its children in an order of its
+    /// own, by the sign of the ray's direction on one axis (bvh-design's `occlusion=sample`):
+    /// kAnyOrderSet, the axis in bits 0-1, the second child first for a positive direction
+    /// (bit 2), for a negative one (bit 3). 0: as the tree's flags order children.
+    std::uint8_t any_order = 0;
 };
+
+/// ModelNode::any_order's flag that the node declares its own any-hit order.
+inline constexpr std::uint8_t kAnyOrderSet = 0x80;
+
+/// Whether a ray whose direction's sign bits are `neg` (RayInv::neg) enters the first child of a
+/// node with any_order `o` (kAnyOrderSet set) first.
+inline bool any_order_first_child_first(std::uint8_t o, const int neg[3]) {
+    return !((o >> (2 + neg[o & 3])) & 1);
+}
 
 /// A 5D ray classification node's directions (`ModelNode::region` is its origin box): dominant
 /// axis `axis` and its sign, u and v ranges (the other two direction components over

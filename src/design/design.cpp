@@ -68,8 +68,7 @@ DesignResult design(const Scene& scene, const DesignOptions& opt) {
             if (fam == k.family) f = &k;
         const HierarchyRequest yardstick = parse_hierarchy_list(f->yardstick, scene.size()).front();
         HierarchyRequest designed{f->designed, design_set(opt, scene)};
-        // The BVH's occlusion order too (the model's replay takes the children front to back, so
-        // its prediction for occlusion rays is then approximate).
+        // The BVH's occlusion order too (its model tree carries the order: ModelNode::any_order).
         if (f->extra) designed.params.push_back(f->extra);
         EvalOptions eo;
         eo.hierarchies = {designed, yardstick, {"embree", {}}};  // Embree: the speed peer, same rays and run

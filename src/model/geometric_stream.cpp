@@ -204,8 +204,17 @@ private:
                 for (std::uint32_t x = 0; x < k; ++x) {
                     double survive = 1.0;
                     if (terminate_ && k == 2) {
-                        // The other child is before X half the time.
-                        survive = 0.5 * (2 - handed_[1 - x] * o.kids[1 - x].p_hit);
+                        // The other child is before X half the time; with the node's own order
+                        // for an any-hit query, as often as its side's directions (half the
+                        // lines go each way along its axis).
+                        double other_first = 0.5;
+                        if (opt_.query == Query::Any && (m.any_order & kAnyOrderSet)) {
+                            const int pos[3] = {0, 0, 0}, neg[3] = {1, 1, 1};
+                            const double first_child_first = 0.5 * any_order_first_child_first(m.any_order, pos) +
+                                                             0.5 * any_order_first_child_first(m.any_order, neg);
+                            other_first = x == 0 ? 1 - first_child_first : first_child_first;
+                        }
+                        survive = 1 - other_first * handed_[1 - x] * o.kids[1 - x].p_hit;
                     } else if (terminate_ && k > 2) {
                         e_.assign(k, 0.0);  // e[j]: elementary symmetric polynomial of degree j
                         e_[0] = 1;

@@ -210,6 +210,7 @@ private:
                     const bool ll = t_.nodes[m.first].leaf, lr = t_.nodes[m.first + 1].leaf;
                     left_first = ll != lr ? ll : sl.t0 < sr.t0;
                 }
+                if (any_ && (m.any_order & kAnyOrderSet)) left_first = any_order_first_child_first(m.any_order, ri_.neg);
                 ty.left_first += left_first;
                 const std::uint32_t near = left_first ? m.first : m.first + 1;
                 const Segment& far = left_first ? sr : sl;

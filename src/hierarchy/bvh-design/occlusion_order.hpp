@@ -28,11 +28,9 @@ public:
         : HierarchyImpl(s), bvh_(s, "bvh-design", std::move(data), true), order_(std::move(order)) {}
 
     std::string_view name() const override { return "bvh-design"; }
-    bool emit_model(ModelSink& sink) const override { return bvh_.emit_model(sink); }
-
-    /// The order bytes are outside the model tree (it takes the children front to back): its
-    /// replay is not the model's prediction.
-    bool replay_is_model() const { return false; }
+    /// The BVH's model tree with the order bytes on its nodes (ModelNode::any_order): the model
+    /// orders occlusion rays as this walk does, so that its replay is the model's prediction.
+    bool emit_model(ModelSink& sink) const override { return bvh_.emit_model_ordered(sink, order_); }
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {

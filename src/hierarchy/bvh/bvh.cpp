@@ -24,7 +24,7 @@ StructureStats Bvh::compute_structure() const {
     return s;
 }
 
-bool Bvh::emit_model(ModelSink& sink) const {
+bool Bvh::emit_model_ordered(ModelSink& sink, std::span<const std::uint8_t> any_order) const {
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     f.cull = ordered_;
     f.cull_widened = ordered_;
@@ -48,6 +48,7 @@ bool Bvh::emit_model(ModelSink& sink) const {
         m.box = n.leaf ? 0.0f : static_cast<float>(n.count);  // a visit tests every child's box
         m.count = n.count;
         m.leaf = n.leaf;
+        if (!n.leaf && n.count == 2 && !any_order.empty()) m.any_order = any_order[i] | kAnyOrderSet;
         if (n.leaf) {
             sink.node(m, std::span<const std::uint32_t>(d_.refs).subspan(n.index, n.count));
             return;

@@ -4,6 +4,7 @@
 // fill `BvhData`.
 
 #include <algorithm>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <vector>
@@ -65,7 +66,10 @@ public:
     Bvh(const Scene& s, std::string name, BvhData data, bool ordered);
 
     std::string_view name() const override { return name_; }
-    bool emit_model(ModelSink& sink) const override;
+    bool emit_model(ModelSink& sink) const override { return emit_model_ordered(sink, {}); }
+    /// emit_model with an any-hit order byte per node (`any_order[i]` for node i, as
+    /// ModelNode::any_order without its flag) on every two-child interior node; none if empty.
+    bool emit_model_ordered(ModelSink& sink, std::span<const std::uint8_t> any_order) const;
     /// The built nodes and references (a traversal of another order reads them: bvh-design).
     const BvhData& data() const { return d_; }
     /// Ordered any-hit (occlusion) queries enter a node's leaf children before its interior ones
