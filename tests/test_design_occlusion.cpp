@@ -4,6 +4,8 @@
 // model tree (ModelNode::any_order).
 #include <gtest/gtest.h>
 
+#include "../src/design/replay.hpp"
+#include "../src/hierarchy/bvh-design/occlusion_order.hpp"
 #include "rtcost/design.hpp"
 #include "rtcost/hierarchy.hpp"
 #include "rtcost/model.hpp"
@@ -51,6 +53,48 @@ TEST(DesignOcclusion, TheOrderChosenCountsNoMoreOnItsSampleThanFrontToBack) {
         }
     }
     EXPECT_GE(fewer, 2);
+}
+
+// The priced order bytes (each subtree's cheapest orders for the sample's rays that enter it):
+// their walk of the sample's occlusion rays, priced in the design's costs, costs no more than
+// the guessed bytes' (ends per primitive), and less on balls' (on tetra's they agree). Every ray
+// that meets the root gets to it, so there the subtree's optimum is the whole walk's: turning
+// either of the root's bits never makes the sample cheaper (the pricing counts what the walk
+// counts).
+TEST(DesignOcclusion, PricedOrdersCostTheSampleNoMoreThanGuessedOnesAndTheRootsAreOptimal) {
+    using Rays = designing::SampleReplay::Rays;
+    int fewer = 0, dearer = 0;
+    for (const char* scene : {"builtin:balls:3", "builtin:tetra:4"}) {
+        const Scene s = load_scene(scene);
+        for (const char* rays : {"rays=shadow", "rays=ao"}) {
+            const DesignInput in = draw_design_input(s, Params(design_param_specs(), {rays, "size=32x32", "sample=600"}));
+            const designing::SampleReplay replay(s, in.sample, in.costs);
+            auto sah = build_hierarchy(s, "bvh-sah");
+            const bvh::BvhData& d = dynamic_cast<const bvh::Bvh&>(*sah).data();
+            const std::vector<std::uint8_t> guess = bvh::occlusion_bits(d, s, in.sample);
+            std::vector<std::uint8_t> priced = guess;
+            bvh::price_occlusion_bits(d, s, in.sample, in.costs, priced);
+            auto cost = [&](const std::vector<std::uint8_t>& bits) {
+                const bvh::DesignedBvh h(s, d, bits);
+                return replay.time(h, replay.counters(h, Rays::Occlusion));
+            };
+            const double best = cost(priced), guessed = cost(guess);
+            const std::string what = std::string(scene) + " " + rays;
+            std::printf("%s: priced %.1f, guessed %.1f\n", what.c_str(), best, guessed);
+            EXPECT_LE(best, guessed * (1 + 1e-12)) << what;
+            fewer += best < guessed * (1 - 1e-3);
+            ASSERT_FALSE(d.nodes[0].leaf);
+            for (int sign = 0; sign < 2; ++sign) {
+                std::vector<std::uint8_t> turned = priced;
+                turned[0] ^= static_cast<std::uint8_t>(1u << (2 + sign));
+                const double c = cost(turned);
+                EXPECT_GE(c, best * (1 - 1e-12)) << what << ": the root's bit for sign " << sign;
+                dearer += c > best * (1 + 1e-12);
+            }
+        }
+    }
+    EXPECT_GE(fewer, 2);
+    EXPECT_GE(dearer, 2);  // the root's order matters somewhere
 }
 
 // A node's own order (ModelNode::any_order) is modelled as that order stored: a tree whose binary

@@ -5,8 +5,8 @@
 // the cheapest tree on half the sample when designed on the other half); a node stays a leaf
 // where no split pays; and the order in which occlusion rays enter
 // a node's children: front to back or leaf children first, whichever the model predicts cheaper
-// on the sample (or, with occlusion=sample, an order per node and direction from the sample, on the
-// designed tree or on bvh-sah's, whichever its own walk prices cheaper on the sample:
+// on the sample (or, with occlusion=sample, an order per node and direction priced on the sample,
+// on the designed tree or on bvh-sah's, whichever its own walk prices cheaper on the sample:
 // occlusion_order.hpp).
 // Otherwise traversed as every BVH (../bvh/bvh.hpp).
 #include <algorithm>
@@ -253,9 +253,9 @@ const Registration reg{
              "occlusion", "auto", {"auto", "near", "leaves", "sample"},
              "order in which occlusion rays enter a node's children: near (front to back, as every BVH), leaves "
              "(leaf children first, then front to back), auto (of near and leaves, the one the model predicts "
-             "cheaper on the sample), or sample (the child likelier to end the ray per primitive first, by node and "
-             "by the way the ray crosses it, on the designed tree or bvh-sah's, or bvh-sah front to back, whichever "
-             "its walk prices cheapest on the sample; outside the model's exact replay)"));
+             "cheaper on the sample), or sample (by node and by the way the ray crosses it, the child whose order "
+             "makes the subtree cheapest for the sample first, on the designed tree or bvh-sah's, or bvh-sah front "
+             "to back, whichever its walk prices cheapest on the sample)"));
          p.push_back(ParamSpec::real("trust", "32", 0, 1e30,
                                      "sample segments at a node at which sample and surface area weigh alike "
                                      "(large: the surface area heuristic)"));
@@ -322,11 +322,13 @@ const Registration reg{
              return by_sah;
          }
          // Of bvh-sah's tree walked front to back and each tree with its order bits, the cheapest
-         // by its own traversal of the sample (the model's replay goes front to back and would
-         // not see an order's gain); a tie keeps the designed splits.
+         // by its own traversal of the sample; a tie keeps the designed splits.
          const designing::SampleReplay replay(s, in.sample, in.costs);
-         auto sah_ordered = std::make_unique<DesignedBvh>(s, by_sah->data(), occlusion_bits(by_sah->data(), s, in.sample));
+         std::vector<std::uint8_t> sah_order = occlusion_bits(by_sah->data(), s, in.sample);
+         price_occlusion_bits(by_sah->data(), s, in.sample, in.costs, sah_order);
+         auto sah_ordered = std::make_unique<DesignedBvh>(s, by_sah->data(), std::move(sah_order));
          std::vector<std::uint8_t> designed_order = occlusion_bits(designed_tree, s, in.sample);
+         price_occlusion_bits(designed_tree, s, in.sample, in.costs, designed_order);
          auto designed_ordered = std::make_unique<DesignedBvh>(s, std::move(designed_tree), std::move(designed_order));
          // bvh-sah's tree takes its other rays alike with its order bytes or without (DesignedBvh
          // orders occlusion rays only): replayed once.

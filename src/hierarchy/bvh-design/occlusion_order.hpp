@@ -1,13 +1,14 @@
 #pragma once
 // bvh-design's hierarchy: the BVH's nodes and traversal for closest-hit and all-hits queries,
-// and for occlusion (any-hit) queries a walk that enters first, at each node, the child the
-// design sample says is likelier to end the ray per unit of its cost (an order byte per node,
-// by the sign of the ray's direction on the node's axis): an any-hit query needs no hit nearer
-// than another, only one soon.
+// and for occlusion (any-hit) queries a walk that enters first, at each node, the child whose
+// order the design sample prices cheaper (an order byte per node, by the sign of the ray's
+// direction on the node's axis): an any-hit query needs no hit nearer than another, only one
+// soon.
 
 #include <vector>
 
 #include "../bvh/bvh.hpp"
+#include "rtcost/model.hpp"
 #include "rtcost/sample.hpp"
 
 namespace rtcost::bvh {
@@ -20,6 +21,12 @@ namespace rtcost::bvh {
 /// Byte: the axis (bits 0-1), second child first for a positive direction (bit 2), for a
 /// negative one (bit 3).
 std::vector<std::uint8_t> occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sample);
+
+/// Refines order bytes `bits` (occlusion_bits') on `sample`: each binary node's bit for each
+/// direction sign becomes the order whose walk of the sample's occlusion rays costs least under
+/// `costs`, the nodes below decided first (occlusion_priced.cpp).
+void price_occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sample, const UnitCosts& costs,
+                          std::vector<std::uint8_t>& bits);
 
 class DesignedBvh final : public HierarchyImpl<DesignedBvh> {
 public:
