@@ -10,11 +10,13 @@
 // occlusion_bits.cpp guesses, this prices; a node or sign that no ray meeting both its children
 // tells apart keeps its guessed bit.
 #include <algorithm>
+#include <array>
+#include <span>
+#include <vector>
 
 #include "occlusion_order.hpp"
 
 namespace rtcost::bvh {
-
 
 void price_occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sample, const UnitCosts& costs,
                           std::vector<std::uint8_t>& bits) {
