@@ -57,8 +57,8 @@ for i in 0 1; do wait "${pids[$i]}" || { status=1; cat "build-asan/shard-$i.log"
 echo "sanitize: asan tests $(t "$start") s"
 
 # ThreadSanitizer: a build of its own, of the library and the threaded tests only
-# (rtcost_thread_tests: test_threads.cpp and test_rc5d.cpp), so that CI holds it beside the
-# ASan build. RTCOST_TSAN=0 skips it.
+# (rtcost_thread_tests: test_threads.cpp, test_rc5d.cpp and test_rc5d_hits.cpp), so that CI
+# holds it beside the ASan build. RTCOST_TSAN=0 skips it.
 if [ "${RTCOST_TSAN:-1}" = 0 ]; then
   echo "sanitize: ThreadSanitizer skipped (RTCOST_TSAN=0)"
   exit 0
