@@ -47,7 +47,8 @@ struct ModelNode {
 inline constexpr std::uint8_t kAnyOrderSet = 0x80;
 
 /// Whether a ray whose direction's sign bits are `neg` (RayInv::neg) enters the first child of a
-/// node with any_order `o` (kAnyOrderSet set) first.
+/// node with any_order `o` first (the flag is not read: bvh-design's order bytes, which lack it,
+/// are decoded alike).
 inline bool any_order_first_child_first(std::uint8_t o, const int neg[3]) {
     return !((o >> (2 + neg[o & 3])) & 1);
 }

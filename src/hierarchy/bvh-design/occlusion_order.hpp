@@ -93,6 +93,8 @@ private:
                         next[nn++] = {n.index + k, e.depth + 1};
                 }
                 if (nn == 2) {
+                    // The byte decoded as any_order_first_child_first does (model_tree.hpp),
+                    // spelled out here: the traversal's code stays the one timed in docs/design.md.
                     const std::uint8_t b = order_[e.node];
                     if ((b >> (2 + ri.neg[b & 3])) & 1) std::swap(next[0], next[1]);
                 }

@@ -75,7 +75,7 @@ void price_occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sam
         const double first = a.cost + (a.ends ? 0.0 : b.cost), second = b.cost + (b.ends ? 0.0 : a.cost);
         sums[node][2 * sign] += first;
         sums[node][2 * sign + 1] += second;
-        const bool second_first = (bits[node] >> (2 + sign)) & 1;
+        const bool second_first = !any_order_first_child_first(bits[node], ri.neg);
         return {interior_cost + (second_first ? second : first), a.ends || b.ends};
     };
     // Each sweep decides every bit from the costs under the previous sweep's bits: the nodes of
