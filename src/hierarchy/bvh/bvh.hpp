@@ -91,6 +91,8 @@ public:
     RayShear shear_of(const Ray& ray) const { return has_triangles_ ? RayShear(ray.d) : RayShear(); }
     /// Fetches what a visit of node `i` reads first (a walk about to wait on memory).
     void prefetch_node(std::uint32_t i) const { prefetch(d_.nodes[i]); }
+    /// Fetches the leaf primitives from leaf order position `first` (a leaf's Node::index).
+    void prefetch_prims(std::uint32_t first) const { __builtin_prefetch(prims_.data() + first); }
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
