@@ -73,8 +73,10 @@ private:
         const std::uint32_t neg_bits = static_cast<std::uint32_t>(ri.neg[0] | ri.neg[1] << 1 | ri.neg[2] << 2);
         counting.box();
         if (box_entry(nodes[0].box, ri, ray.tmin, ray.tmax) == kInf) return false;
-        // The leaves' tests of bvh-sah's walk: triangle copies in leaf order, one shear per ray.
-        const RayShear shear = bvh_.shear_of(ray);
+        // The leaves' tests of bvh-sah's walk: triangle copies in leaf order, one shear per ray,
+        // made at the first leaf.
+        RayShear shear;
+        bool sheared = false;
         bool found = false;
         struct Entry {
             std::uint32_t node;
@@ -87,6 +89,7 @@ private:
             const Node& n = nodes[e.node];
             if (n.leaf) {
                 counting.leaf(e.depth, n.count);
+                if (!sheared) shear = bvh_.shear_of(ray), sheared = true;
                 if (bvh_.template test_leaf_of<C, Query::Any>(n, ray, shear, hit, counting, found, test)) return true;
             } else {
                 counting.interior(e.depth);

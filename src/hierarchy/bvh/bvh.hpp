@@ -124,8 +124,10 @@ private:
         int sp = 0;
         const Node* nodes = d_.nodes.data();
         const RayInv ri(ray);
-        // Three divisions a ray pays only where there are triangles to test (not in a scene of spheres).
-        const RayShear shear = shear_of(ray);
+        // Three divisions a ray pays only where it reaches a leaf with triangles to test (not in a
+        // scene of spheres, nor on the shadow rays of a mesh that reach no leaf).
+        RayShear shear;
+        bool sheared = !has_triangles_;
         counting.box();
         float t0 = box_entry(nodes[0].box, ri, ray.tmin, ray.tmax);
         if (t0 == kInf) return false;
@@ -142,6 +144,7 @@ private:
                 const Node& n = nodes[e.node];
                 if (n.leaf) {
                     counting.leaf(e.depth, n.count);
+                    if (!sheared) shear = RayShear(ray.d), sheared = true;
                     if (test_leaf<C, Q>(n.index, n.count, ray, shear, hit, counting, found, test)) return true;
                     goto pop;
                 }
