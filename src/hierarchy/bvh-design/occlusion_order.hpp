@@ -102,7 +102,8 @@ private:
                     const float ta = box_entry(nodes[n.index].box, ri, ray.tmin, ray.tmax);
                     const float tb = box_entry(nodes[n.index + 1].box, ri, ray.tmin, ray.tmax);
                     // The byte decoded as any_order_first_child_first does (model_tree.hpp),
-                    // spelled out here: the traversal's code stays the one timed in docs/design.md.
+                    // from the packed count and the signs held in neg_bits (the walk timed in
+                    // docs/design.md on 2026-12-06).
                     const std::uint32_t b = n.count >> kOrderShift;
                     const std::uint32_t second = (b >> (2 + ((neg_bits >> (b & 3)) & 1))) & 1;
                     std::uint32_t first_child = n.index, other = n.index + 1;
