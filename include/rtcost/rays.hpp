@@ -20,6 +20,25 @@ class Hierarchy;
 /// direction is not normalised: its component along the view axis is 1, so tmin = hither clips
 /// at the hither plane exactly.
 std::vector<Ray> camera_rays(const Camera& cam, int width, int height);
+/// The eye ray of any one pixel of camera_rays' image, bit for bit its element: for a subset of
+/// the pixels (a ray sample's), without making the whole image's rays.
+class CameraRay {
+public:
+    CameraRay(const Camera& cam, int width, int height);
+    /// The ray of pixel `pixel` (row-major, from the top left).
+    Ray operator()(std::size_t pixel) const;
+    /// The ray through image point (u, v), in pixels right and up of the image's centre.
+    Ray through(double u, double v) const {
+        return Ray{from_, fwd_ + right_ * static_cast<float>(u * scale_) + up_ * static_cast<float>(v * scale_), hither_,
+                   kInf};
+    }
+
+private:
+    Vec3 from_, fwd_, right_, up_;
+    double scale_;
+    float hither_;
+    int width_, height_;
+};
 /// `n` eye rays of the same camera through uniformly random points of its `width` x `height`
 /// image (between its outermost pixel centres, not at them); directions as camera_rays'.
 std::vector<Ray> view_rays(const Camera& cam, int width, int height, std::size_t n, std::uint64_t seed);

@@ -18,47 +18,46 @@ Vec3 normalize_double(Vec3 v) {
     return {static_cast<float>(v.x / l), static_cast<float>(v.y / l), static_cast<float>(v.z / l)};
 }
 
-/// A camera's image plane: the ray through image point (u, v), in pixels from the image's centre,
-/// has direction fwd + right u scale + up v scale (not normalised: its component along the view
-/// axis is 1).
-struct ImagePlane {
-    Vec3 fwd, right, up;
-    double scale;  // tangent of the angle one pixel spans at the centre
-    ImagePlane(const Camera& cam, int height) {
-        // Normalised in double: a short view vector or up vector underflows in float to NaN rays.
-        fwd = normalize_double(cam.at - cam.from);
-        right = normalize_double(cross(fwd, normalize_double(cam.up)));
-        up = cross(right, fwd);
-        // NFF: the angle spans from the centre of the top pixel row to the centre of the bottom one.
-        const double half = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0);
-        scale = height > 1 ? half / (0.5 * (height - 1)) : 0.0;
-    }
-    Vec3 direction(double u, double v) const {
-        return fwd + right * static_cast<float>(u * scale) + up * static_cast<float>(v * scale);
-    }
-};
-
 }  // namespace
 
+// The image plane: the ray through image point (u, v), in pixels from the image's centre, has
+// direction fwd + right u scale + up v scale (not normalised: its component along the view axis
+// is 1).
+CameraRay::CameraRay(const Camera& cam, int width, int height)
+    : from_(cam.from), hither_(cam.hither), width_(width), height_(height) {
+    // Normalised in double: a short view vector or up vector underflows in float to NaN rays.
+    fwd_ = normalize_double(cam.at - cam.from);
+    right_ = normalize_double(cross(fwd_, normalize_double(cam.up)));
+    up_ = cross(right_, fwd_);
+    // NFF: the angle spans from the centre of the top pixel row to the centre of the bottom one.
+    const double half = std::tan(0.5 * cam.angle * std::numbers::pi / 180.0);
+    scale_ = height > 1 ? half / (0.5 * (height - 1)) : 0.0;
+}
+
+Ray CameraRay::operator()(std::size_t pixel) const {
+    const auto w = static_cast<std::size_t>(width_);
+    const int i = static_cast<int>(pixel % w), j = static_cast<int>(pixel / w);
+    return through(i + 0.5 - 0.5 * width_, 0.5 * height_ - j - 0.5);
+}
+
 std::vector<Ray> camera_rays(const Camera& cam, int width, int height) {
-    const ImagePlane plane(cam, height);
+    const CameraRay ray(cam, width, height);
     std::vector<Ray> rays;
-    rays.reserve(static_cast<std::size_t>(width) * height);
-    for (int j = 0; j < height; ++j)
-        for (int i = 0; i < width; ++i)
-            rays.push_back(Ray{cam.from, plane.direction(i + 0.5 - 0.5 * width, 0.5 * height - j - 0.5), cam.hither, kInf});
+    const std::size_t n = static_cast<std::size_t>(width) * height;
+    rays.reserve(n);
+    for (std::size_t p = 0; p < n; ++p) rays.push_back(ray(p));
     return rays;
 }
 
 std::vector<Ray> view_rays(const Camera& cam, int width, int height, std::size_t n, std::uint64_t seed) {
-    const ImagePlane plane(cam, height);
+    const CameraRay plane(cam, width, height);
     Rng rng(seed);
     std::vector<Ray> rays;
     rays.reserve(n);
     for (std::size_t k = 0; k < n; ++k) {
         // Uniform over the span of the pixel centres, as camera_rays covers it.
         const double u = (rng.uniform() - 0.5) * (width - 1), v = (rng.uniform() - 0.5) * (height - 1);
-        rays.push_back(Ray{cam.from, plane.direction(u, v), cam.hither, kInf});
+        rays.push_back(plane.through(u, v));
     }
     return rays;
 }
@@ -159,15 +158,16 @@ const RayDistributionRegistration kCamera{
          if (!spec.size.empty()) parse_size(spec.size, "--size", w, h);
          const std::size_t n = static_cast<std::size_t>(w) * h;
          check_pixel_subset(making.only_pixels, n);
-         std::vector<Ray> rays = camera_rays(scene.camera, w, h);
+         std::vector<Ray> rays;
          std::vector<std::uint32_t> pixels;
          if (making.only_pixels) {
+             // Only those pixels' rays (a sample's), not the whole image's.
              pixels = *making.only_pixels;
-             std::vector<Ray> some;
-             some.reserve(pixels.size());
-             for (std::uint32_t p : pixels) some.push_back(rays[p]);
-             rays = std::move(some);
+             const CameraRay ray(scene.camera, w, h);
+             rays.reserve(pixels.size());
+             for (std::uint32_t p : pixels) rays.push_back(ray(p));
          } else {
+             rays = camera_rays(scene.camera, w, h);
              pixels.resize(n);
              for (std::size_t i = 0; i < n; ++i) pixels[i] = static_cast<std::uint32_t>(i);
          }

@@ -171,7 +171,8 @@ using detail::cosine_direction;
 
 RayTree whitted_tree(const Hierarchy& h, const WhittedOptions& opt) {
     const Scene& scene = h.scene();
-    const std::vector<Ray> eye = camera_rays(scene.camera, opt.width, opt.height);
+    // Each pixel's eye ray made where it is traced: a sample traces a few pixels of the image.
+    const CameraRay eye(scene.camera, opt.width, opt.height);
     detail::WhittedTracer tracer(h, opt.max_depth, opt.shadow_tests);
     std::vector<Recorder> rows(static_cast<std::size_t>(opt.height));
     detail::run_rows(
@@ -181,7 +182,7 @@ RayTree whitted_tree(const Hierarchy& h, const WhittedOptions& opt) {
             rec.keep = opt.record;
             detail::for_pixels_of_row(j, opt.width, opt.pixels, [&](int, std::size_t pixel) {
                 rec.pixel = static_cast<std::uint32_t>(pixel);
-                tracer.trace(eye[pixel], RayKind::Eye, 1, &rec);
+                tracer.trace(eye(pixel), RayKind::Eye, 1, &rec);
             });
         },
         opt.progress);
@@ -192,7 +193,7 @@ RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int 
                         int threads, const std::function<void(std::size_t)>& progress, bool test_spawned,
                         const std::vector<std::uint32_t>* pixels) {
     const Scene& scene = h.scene();
-    const std::vector<Ray> eye = camera_rays(scene.camera, width, height);
+    const CameraRay eye(scene.camera, width, height);  // as whitted_tree's
     detail::WhittedTracer tracer(h, 1);
     const float eps = spawn_offset(scene), ao = ao_length(scene);
     std::vector<Recorder> rows(static_cast<std::size_t>(height));
@@ -202,7 +203,7 @@ RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int 
             Recorder& rec = rows[j];
             detail::for_pixels_of_row(j, width, pixels, [&](int, std::size_t pixel) {
                 rec.pixel = static_cast<std::uint32_t>(pixel);
-                const Ray& ray = eye[pixel];
+                const Ray ray = eye(pixel);
                 Hit hit;
                 h.closest(ray, hit);
                 rec.count(RayKind::Eye, hit.hit());
