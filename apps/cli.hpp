@@ -54,6 +54,10 @@ std::unique_ptr<Hierarchy> build(const Scene& scene, const BuildArgs& a, const C
 
 /// --rays, --size, --count, --seed into `spec`.
 void add_ray_args(CLI::App* cmd, RaySpec& spec);
+/// A whole number in [lo, hi], checked on the text as typed. CLI11 reads "-1" into an unsigned
+/// option as its wrapped value and a number beyond 64 bits as the largest one, both silently:
+/// every unsigned count and seed of the command line takes this check.
+CLI::Validator whole_number(std::uint64_t lo, std::uint64_t hi = UINT64_MAX);
 /// --camera and --light into `view`.
 void add_view_args(CLI::App* cmd, ViewSpec& view);
 

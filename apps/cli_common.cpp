@@ -1,6 +1,7 @@
 // Shared pieces of the command line (see cli.hpp).
 #include "cli.hpp"
 
+#include <charconv>
 #include <cstdio>
 #include <filesystem>
 #include <unistd.h>
@@ -21,6 +22,19 @@ void add_common(CLI::App* cmd, Common& common, bool with_json) {
     cmd->add_flag("-q,--quiet", common.quiet, "no progress and no warnings on stderr");
 }
 
+CLI::Validator whole_number(std::uint64_t lo, std::uint64_t hi) {
+    return CLI::Validator(
+        [lo, hi](std::string& text) -> std::string {
+            std::uint64_t v = 0;
+            const char* end = text.data() + text.size();
+            const auto [at, ec] = std::from_chars(text.data(), end, v);  // no sign, no overflow
+            if (text.empty() || ec != std::errc{} || at != end || v < lo || v > hi)
+                return fmt::format("'{}' is not a whole number in [{}, {}]", text, lo, hi);
+            return {};
+        },
+        fmt::format("in [{} - {}]", lo, hi));
+}
+
 void add_ray_args(CLI::App* cmd, RaySpec& spec) {
     std::string names;
     for (const auto& n : distribution_names()) names += (names.empty() ? "" : ", ") + n;
@@ -28,9 +42,9 @@ void add_ray_args(CLI::App* cmd, RaySpec& spec) {
         ->capture_default_str();
     cmd->add_option("--size", spec.size, "image size WxH for camera-based rays (default: the scene's)");
     cmd->add_option("--count", spec.count, "number of rays for lines and random")
-        ->check(CLI::Range(std::size_t{1}, static_cast<std::size_t>(kMaxRays)))
+        ->check(whole_number(1, kMaxRays))
         ->capture_default_str();
-    cmd->add_option("--seed", spec.seed, "seed for random distributions")->capture_default_str();
+    cmd->add_option("--seed", spec.seed, "seed for random distributions")->check(whole_number(0))->capture_default_str();
     add_view_args(cmd, spec.view);
 }
 

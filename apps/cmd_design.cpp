@@ -46,8 +46,13 @@ Subcommand setup_design(CLI::App& parent, Common& common) {
     add_view_args(cmd, a->opt.rays.view);
     cmd->add_option("--family", a->families, "families to design, comma-separated (grid, bvh, ...), or all")
         ->capture_default_str();
-    cmd->add_option("--sample", a->opt.sample, "rays in the design sample")->capture_default_str();
-    cmd->add_option("--seed", a->opt.seed, "seed of the sample's draw")->capture_default_str();
+    // The ranges of the designed hierarchies' own `--set sample=` and `seed=` (design_param_specs).
+    cmd->add_option("--sample", a->opt.sample, "rays in the design sample")
+        ->check(whole_number(1, std::uint64_t{1} << 20))
+        ->capture_default_str();
+    cmd->add_option("--seed", a->opt.seed, "seed of the sample's draw")
+        ->check(whole_number(0, std::uint64_t{1} << 62))
+        ->capture_default_str();
     cmd->add_option("--costs", a->opt.costs_file, "what the designs minimise: a costs file of rtcost calibrate (its ns per operation; the table too), unit (operation counts), ops (operation counts, a polygon's edges at a share of its test), typical (built-in ns per operation) or typical-bvh (built-in, a BVH's box test against its primitive tests); default: each family's own (typical-bvh for bvh, typical for kd, ops for grid, octree and bsp)");
     cmd->add_flag("--control", a->opt.control,
                   "also build and evaluate each family's structures a second time, the yardstick first: how far apart "

@@ -134,7 +134,8 @@ Subcommand setup_eval(CLI::App& parent, Common& common) {
         ->capture_default_str();
     eval->add_option("--sample", a->sample,
                      "rays in the sample: training rays for sampled (default 20000), the drawn sample for segments "
-                     "(default 2% of the rays, at most 4096)");
+                     "(default 2% of the rays, at most 4096)")
+        ->check(whole_number(1, kMaxRays));
     eval->add_option("--sample-file", a->sample_file, "the segments estimator's sample, from rtcost sample");
     eval->add_option("--costs", a->costs, "unit costs file (JSON, from rtcost calibrate)");
     eval->add_flag("--by-depth", a->by_depth, "predicted and measured visits per depth");

@@ -74,8 +74,10 @@ Subcommand setup_rays(CLI::App& parent, Common& common) {
     cmd->add_option("-o,--out", a->out, "write the rays here (8 float32 per ray); without it, only the counts");
     cmd->add_option("--size", a->spec.size,
                     "image size WxH (spd: 512x512, eye rays through its (W+1)x(H+1) corners; others: the scene's)");
-    cmd->add_option("--count", a->spec.count, "number of rays for lines and random")->capture_default_str();
-    cmd->add_option("--seed", a->spec.seed, "seed for random distributions")->capture_default_str();
+    cmd->add_option("--count", a->spec.count, "number of rays for lines and random")
+        ->check(whole_number(1, kMaxRays))
+        ->capture_default_str();
+    cmd->add_option("--seed", a->spec.seed, "seed for random distributions")->check(whole_number(0))->capture_default_str();
     add_view_args(cmd, a->spec.view);
     cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
     add_common(cmd, common);

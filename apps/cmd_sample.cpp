@@ -65,10 +65,13 @@ Subcommand setup_sample(CLI::App& parent, Common& common) {
     cmd->add_option("SCENE", a->scene, "scene file or builtin:NAME[:level]")->required();
     cmd->add_option("-r,--rays", a->rays.name, "the distribution to sample (see rtcost rays)")->capture_default_str();
     cmd->add_option("--size", a->rays.size, "image size WxH for camera-based rays (default: the scene's)");
-    cmd->add_option("--count", a->count, "rays in the sample")->capture_default_str();
+    cmd->add_option("--count", a->count, "rays in the sample")->check(whole_number(1, kMaxRays))->capture_default_str();
     cmd->add_option("--population", a->rays.count, "rays of lines and random distributions to sample from")
+        ->check(whole_number(1, kMaxRays))
         ->capture_default_str();
-    cmd->add_option("--seed", a->rays.seed, "seed of the distribution and of the draw")->capture_default_str();
+    cmd->add_option("--seed", a->rays.seed, "seed of the distribution and of the draw")
+        ->check(whole_number(0))
+        ->capture_default_str();
     cmd->add_option("-o,--out", a->out, "sample file to write")->required();
     add_view_args(cmd, a->rays.view);
     cmd->add_option("--query", a->query, "query of the rays that are not occlusion rays: closest, any or all")

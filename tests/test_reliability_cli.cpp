@@ -55,6 +55,42 @@ TEST(ReliabilityCli, CountSizeAndThreadsAreValidatedClearly) {
                      "training and test rays");
 }
 
+// Every unsigned count and seed of every command: a negative number, one beyond 64 bits and
+// text are refused by name, with the value as typed (CLI11 alone read "-1" as 2^64 - 1, and a
+// number beyond 64 bits as that too: `rays --count -1` died in vector::reserve, `sample --count
+// -1` wrote a sample, `design --sample -5` was blamed on "--set: sample=18446744073709551611").
+TEST(ReliabilityCli, UnsignedOptionsRefuseNegativeHugeAndTextAsTyped) {
+    const fs::path out = dir() / "refused.smp";
+    const std::string sample = "sample builtin:tetra:2 --rays camera --size 8x8 --out " + out.string();
+    struct Case {
+        std::string args, option;
+    };
+    const Case cases[] = {
+        {"rays builtin:tetra:2 --rays lines --count", "--count"},
+        {"rays builtin:tetra:2 --rays random --seed", "--seed"},
+        {"trace builtin:tetra:2 -H bvh-sah --rays random --seed", "--seed"},
+        {sample + " --count", "--count"},
+        {sample + " --seed", "--seed"},
+        {"sample builtin:tetra:2 --rays lines --out " + out.string() + " --population", "--population"},
+        {"eval builtin:tetra:2 -H bvh-sah --rays camera --size 8x8 --estimator segments --sample", "--sample"},
+        {"design builtin:tetra:2 --rays camera --size 8x8 --family grid --sample", "--sample"},
+        {"design builtin:tetra:2 --rays camera --size 8x8 --family grid --seed", "--seed"},
+    };
+    for (const Case& c : cases)
+        for (const std::string value : {"-1", "99999999999999999999", "abc"}) {
+            const CliResult r = rtcost(c.args + " " + value + " -q");
+            EXPECT_BAD_INPUT(r, c.option + ": '" + value + "' is not a whole number");
+        }
+    EXPECT_FALSE(fs::exists(out));
+    // The bounds are those of the designed hierarchies' own parameters (--set sample=, seed=).
+    EXPECT_BAD_INPUT(rtcost("design builtin:tetra:2 --family grid --sample 2000000 -q"), "in [1, 1048576]");
+    EXPECT_BAD_INPUT(rtcost("design builtin:tetra:2 --family grid --seed 9223372036854775807 -q"),
+                     "in [0, 4611686018427387904]");
+    // The largest seed is taken.
+    const CliResult r = rtcost("rays builtin:tetra:2 --rays random --count 10 --seed 18446744073709551615 -q");
+    EXPECT_EQ(r.code, 0) << r.err;
+}
+
 TEST(ReliabilityCli, RayFileThatIsADirectoryIsNamed) {
     const std::string d = dir().string();
     EXPECT_BAD_INPUT(rtcost("trace builtin:tetra:2 --rays " + d), d + ": is a directory");

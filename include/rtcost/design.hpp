@@ -42,7 +42,7 @@ struct DesignInput {
 
 /// Reads the design parameters from `p` and draws the sample: `sample` rays of the distribution
 /// `rays` (seed 1 for the distribution, `seed` for the draw, as `rtcost eval --estimator
-/// segments --sample-seed` draws it), their ends found with a bvh-sah built here. The sample is
+/// segments --seed` draws it), their ends found with a bvh-sah built here. The sample is
 /// capped at half the distribution's rays. Throws InputError for bad values.
 DesignInput draw_design_input(const Scene& scene, const Params& p);
 
