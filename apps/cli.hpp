@@ -58,6 +58,8 @@ void add_ray_args(CLI::App* cmd, RaySpec& spec);
 /// option as its wrapped value and a number beyond 64 bits as the largest one, both silently:
 /// every unsigned count and seed of the command line takes this check.
 CLI::Validator whole_number(std::uint64_t lo, std::uint64_t hi = UINT64_MAX);
+/// A finite number above 0, checked on the text as typed (CLI::PositiveNumber takes "nan").
+CLI::Validator positive_number();
 /// --camera and --light into `view`.
 void add_view_args(CLI::App* cmd, ViewSpec& view);
 

@@ -2,6 +2,7 @@
 #include "cli.hpp"
 
 #include <charconv>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <unistd.h>
@@ -33,6 +34,19 @@ CLI::Validator whole_number(std::uint64_t lo, std::uint64_t hi) {
             return {};
         },
         fmt::format("in [{} - {}]", lo, hi));
+}
+
+CLI::Validator positive_number() {
+    return CLI::Validator(
+        [](std::string& text) -> std::string {
+            double v = 0;
+            const char* end = text.data() + text.size();
+            const auto [at, ec] = std::from_chars(text.data(), end, v);
+            if (text.empty() || ec != std::errc{} || at != end || !std::isfinite(v) || !(v > 0))
+                return fmt::format("'{}' is not a finite number above 0", text);
+            return {};
+        },
+        "above 0");
 }
 
 void add_ray_args(CLI::App* cmd, RaySpec& spec) {

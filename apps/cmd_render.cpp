@@ -157,7 +157,7 @@ Subcommand setup_render(CLI::App& parent, Common& common) {
     cmd->add_option("--costs", a->costs, "unit costs file (from rtcost calibrate) for --heatmap ops");
     cmd->add_option("--scale-max", a->scale_max, "top of the heat map's colour scale (default: the largest value), "
                                                  "to compare hierarchies on one scale")
-        ->check(CLI::PositiveNumber);
+        ->check(positive_number());
     cmd->add_flag("--log-scale", a->log, "heat map colours by log(1 + value), for costs that span decades");
     add_common(cmd, common);
     cmd->footer(hierarchy_footer());

@@ -129,7 +129,7 @@ Subcommand setup_report(CLI::App& parent, Common& common) {
         ->capture_default_str();
     cmd->add_option("--heatmap-size", a->heatmap_size, "heat maps' size WxH (default: --size, else 256x256)");
     cmd->add_option("--scale-max", a->scale_max, "top of the heat maps' colour scale (default: the largest value)")
-        ->check(CLI::PositiveNumber);
+        ->check(positive_number());
     cmd->add_flag("--log-scale", a->log, "heat map colours by log(1 + value), for costs that span decades");
     cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024));
     cmd->add_flag("--no-design", a->no_design, "leave out the design section (each family's hierarchy designed for "

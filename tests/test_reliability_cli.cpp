@@ -91,6 +91,22 @@ TEST(ReliabilityCli, UnsignedOptionsRefuseNegativeHugeAndTextAsTyped) {
     EXPECT_EQ(r.code, 0) << r.err;
 }
 
+// A heat map's scale top: CLI::PositiveNumber took "nan" (a map scaled by NaN was written) and 0.
+TEST(ReliabilityCli, ScaleMaxIsAFiniteNumberAboveZero) {
+    const fs::path png = dir() / "scaled.png", html = dir() / "scaled.html";
+    for (const std::string value : {"nan", "inf", "-1", "0", "1x"}) {
+        EXPECT_BAD_INPUT(rtcost("render builtin:tetra:2 --heatmap box --scale-max " + value + " -q -o " + png.string()),
+                         "--scale-max: '" + value + "' is not a finite number above 0");
+        EXPECT_BAD_INPUT(rtcost("report builtin:tetra:2 --scale-max " + value + " -q -o " + html.string()),
+                         "--scale-max: '" + value + "' is not a finite number above 0");
+    }
+    EXPECT_FALSE(fs::exists(png));
+    EXPECT_FALSE(fs::exists(html));
+    const CliResult r = rtcost("render builtin:tetra:2 --heatmap box --scale-max 2.5e1 -q -o " + png.string());
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(fs::exists(png));
+}
+
 TEST(ReliabilityCli, RayFileThatIsADirectoryIsNamed) {
     const std::string d = dir().string();
     EXPECT_BAD_INPUT(rtcost("trace builtin:tetra:2 --rays " + d), d + ": is a directory");
