@@ -11,6 +11,9 @@
 // found either one best depending on the scene), and of the two, and of kd-sah's own
 // termination, the model's cheapest on the sample, its size's cache misses included, is kept
 // (design/cheaper.hpp).
+#include <oneapi/tbb/parallel_for.h>
+#include <oneapi/tbb/task_group.h>
+
 #include "../kd/kdtree.hpp"
 #include "design/cell_rays.hpp"
 #include "prune.hpp"
@@ -46,27 +49,44 @@ const Registration reg{
          SahOptions usual = usual_sah;  // kd-sah's defaults, with this tree's depth and assignment
          usual.build = build;
          usual.build.max_prims = 1;
-         auto usual_tree = std::make_unique<KdTree>(s, "kd-design", build_sah(s, usual), p.flag("mailbox"));
+         // kd-sah's planes down to where even a cheap traversal (a quarter of a test) stops paying
+         // by the SAH, for each bonus; then the model's pruning.
+         std::vector<SahOptions> deep(bonuses.size(), usual_sah);
+         for (std::size_t i = 0; i < bonuses.size(); ++i) {
+             deep[i].build = build;
+             deep[i].c_trav = deep[i].c_isect / 4;
+             deep[i].empty_bonus = bonuses[i];
+         }
+         // The yardstick's tree and each bonus's deep tree are independent single-threaded builds:
+         // built side by side where there are cores (on balls-mesh, 5.4 s one after the other).
+         // Each is the same tree either way.
+         KdData usual_data;
+         std::vector<KdData> deep_data(bonuses.size());
+         {
+             tbb::task_group builds;
+             builds.run([&] { usual_data = build_sah(s, usual); });
+             for (std::size_t i = 0; i < bonuses.size(); ++i)
+                 builds.run([&, i] {
+                     const Chooser choose = [&deep, i](const std::vector<BuildRef>& refs, const Box3& cell, int) {
+                         return sah_plane(refs, cell, deep[i], false);
+                     };
+                     deep_data[i] = build_tree(s, deep[i].build, choose);
+                 });
+             builds.wait();
+         }
+         auto usual_tree = std::make_unique<KdTree>(s, "kd-design", std::move(usual_data), p.flag("mailbox"));
          // A node visit's price: a step, and with a calibrated time model the cache misses of a
          // structure of the yardstick's size (the designed tree's own size is known only once
          // built; a costs file without the time model's terms prices neither).
          const double k_step = in.costs.step + in.costs.cache * in.costs.cache_doublings(usual_tree->structure().bytes);
-         std::vector<std::unique_ptr<KdTree>> trees;  // a tie keeps the earlier: kd-sah's bonus first
-         for (float bonus : bonuses) {
-             // An interior visit of kd-sah's traversal, beyond the step any visit takes: one plane.
+         // Each deep tree pruned (an interior visit of kd-sah's traversal, beyond the step any
+         // visit takes: one plane); a tie keeps the earlier: kd-sah's bonus first.
+         std::vector<std::unique_ptr<KdTree>> trees(bonuses.size());
+         tbb::parallel_for(std::size_t{0}, bonuses.size(), [&](std::size_t i) {
              const designing::CellRays cells(s, in, p.real("trust"), in.costs.plane, k_step);
-             // kd-sah's planes down to where even a cheap traversal (a quarter of a test) stops
-             // paying by the SAH, then the model's pruning.
-             SahOptions deep = usual_sah;
-             deep.build = build;
-             deep.c_trav = deep.c_isect / 4;
-             deep.empty_bonus = bonus;
-             const Chooser choose = [&deep](const std::vector<BuildRef>& refs, const Box3& cell, int) {
-                 return sah_plane(refs, cell, deep, false);
-             };
-             trees.push_back(std::make_unique<KdTree>(s, "kd-design", prune(build_tree(s, deep.build, choose), cells),
-                                                      p.flag("mailbox")));
-         }
+             trees[i] = std::make_unique<KdTree>(s, "kd-design", prune(deep_data[i], cells), p.flag("mailbox"));
+             deep_data[i] = KdData{};
+         });
          trees.push_back(std::move(usual_tree));
          return designing::cheapest_on_sample(std::move(trees), s, in);
      },
