@@ -1,4 +1,5 @@
 // `rtcost eval`: predict each hierarchy's cost with the model, measure it, compare and rank.
+#include <algorithm>
 #include <iostream>
 #include <map>
 
@@ -63,6 +64,13 @@ int cmd_eval(EvalArgs& a, const Common& common) {
                                      : std::vector<Preset>{a.preset == "paper" ? Preset::Paper : Preset::Exact};
     opt.query = parse_query(a.query);
     opt.occlusion = parse_query(a.shadow);
+    // With a sample file, --sample is only the sampled estimator's training rays: without that
+    // estimator it would be ignored.
+    if (a.sample > 0 && !a.sample_file.empty() &&
+        std::find(opt.estimators.begin(), opt.estimators.end(), Estimator::Sampled) == opt.estimators.end())
+        throw InputError("--sample", 0,
+                         "the segments estimator's sample is --sample-file's, and no other estimator asked for takes "
+                         "--sample (the sampled one's training rays)");
     if (a.sample > 0) opt.sample = opt.segments = a.sample;
     opt.sample_file = a.sample_file;
     opt.sample_seed = a.rays.seed;

@@ -91,6 +91,22 @@ TEST(ReliabilityCli, UnsignedOptionsRefuseNegativeHugeAndTextAsTyped) {
     EXPECT_EQ(r.code, 0) << r.err;
 }
 
+// With --sample-file, --sample is only the sampled estimator's training rays: without that
+// estimator it was ignored without a word (and the header said the file's sample took "0.00 s to
+// draw").
+TEST(ReliabilityCli, SampleBesideASampleFileNeedsTheSampledEstimator) {
+    const fs::path smp = dir() / "beside.smp";
+    const std::string scene = "builtin:tetra:2 --rays camera --size 16x16";
+    ASSERT_EQ(rtcost("sample " + scene + " --count 20 -q --out " + smp.string()).code, 0);
+    const std::string eval = "eval " + scene + " -H bvh-sah --sample-file " + smp.string();
+    EXPECT_BAD_INPUT(rtcost(eval + " --estimator segments --sample 5"), "--sample: the segments estimator's sample is");
+    CliResult r = rtcost(eval + " --estimator segments,sampled --sample 50 -q");
+    EXPECT_EQ(r.code, 0) << r.err;
+    r = rtcost(eval + " --estimator segments -q");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(has(r.out, "a sample of 20 rays (read from " + smp.string() + ")")) << r.out;
+}
+
 // A heat map's scale top: CLI::PositiveNumber took "nan" (a map scaled by NaN was written) and 0.
 TEST(ReliabilityCli, ScaleMaxIsAFiniteNumberAboveZero) {
     const fs::path png = dir() / "scaled.png", html = dir() / "scaled.html";

@@ -120,7 +120,8 @@ struct EvalResult {
     std::size_t test_rays = 0, training_rays = 0;
     std::size_t sample_rays = 0;       ///< the segments estimator's sample (disjoint from the test rays)
     std::size_t distribution_rays = 0; ///< every ray of the distribution, before any was set apart
-    double sample_seconds = 0;         ///< drawing it (once for every hierarchy)
+    double sample_seconds = 0;         ///< drawing it (once for every hierarchy), or reading it
+    std::string sample_file;           ///< where it was read from (EvalOptions::sample_file); empty: drawn
     /// The geometric estimator's visibility sample (draw_visibility_sample; under termination).
     std::size_t visibility_rays = 0;
     double visibility_seconds = 0;

@@ -397,6 +397,7 @@ EvalResult evaluate(const Scene& scene, const RaySpec& spec, const EvalOptions& 
     }
     EvalResult r = run(scene, std::move(test), train, sample ? &*sample : nullptr, opt, split);
     r.sample_seconds = sample_seconds;
+    if (sample) r.sample_file = opt.sample_file;
     r.distribution_rays = whole;
     return r;
 }
@@ -413,6 +414,7 @@ EvalResult evaluate(const Scene& scene, RaySet rays, const EvalOptions& opt) {
     }
     EvalResult r = run(scene, std::move(rays), train, sample ? &*sample : nullptr, opt, split);
     r.sample_seconds = sample_seconds;
+    if (sample) r.sample_file = opt.sample_file;
     r.distribution_rays = whole;
     return r;
 }

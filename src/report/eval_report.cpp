@@ -138,8 +138,9 @@ std::string eval_header(const EvalResult& r) {
     const Estimator est = r.estimators.front();
     std::string split = r.split == "none" ? "no rays held out"
                         : r.split == "sample"
-                            ? fmt::format("a sample of {} rays ({:.2f} s to draw) left out of them", r.sample_rays,
-                                          r.sample_seconds)
+                            ? fmt::format("a sample of {} rays ({}) left out of them", r.sample_rays,
+                                          r.sample_file.empty() ? fmt::format("{:.2f} s to draw", r.sample_seconds)
+                                                                : "read from " + r.sample_file)
                             : fmt::format("{} training rays ({}) left out of them", r.training_rays, r.split);
     if (r.split.find(" and ") != std::string::npos)
         split = fmt::format("a sample of {} rays and {} training rays left out of them", r.sample_rays, r.training_rays);
