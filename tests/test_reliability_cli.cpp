@@ -105,6 +105,9 @@ TEST(ReliabilityCli, SampleBesideASampleFileNeedsTheSampledEstimator) {
     r = rtcost(eval + " --estimator segments -q");
     EXPECT_EQ(r.code, 0) << r.err;
     EXPECT_TRUE(has(r.out, "a sample of 20 rays (read from " + smp.string() + ")")) << r.out;
+    r = rtcost(eval + " --estimator segments -q --json");
+    EXPECT_EQ(r.code, 0) << r.err;
+    EXPECT_TRUE(has(r.out, "\"sample_file\": \"" + smp.string() + "\"")) << r.out;
 }
 
 // A heat map's scale top: CLI::PositiveNumber took "nan" (a map scaled by NaN was written) and 0.

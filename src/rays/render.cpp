@@ -12,7 +12,7 @@ namespace rtcost {
 
 Image render(const Hierarchy& h, const RenderOptions& opt) {
     const Scene& scene = h.scene();
-    const std::vector<Ray> eye = camera_rays(scene.camera, opt.width, opt.height);
+    const CameraRay eye(scene.camera, opt.width, opt.height);  // as whitted_tree's
     detail::WhittedTracer tracer(h, opt.max_depth);
     Image img;
     img.width = opt.width;
@@ -26,7 +26,7 @@ Image render(const Hierarchy& h, const RenderOptions& opt) {
         [&](int j) {
             for (int i = 0; i < opt.width; ++i) {
                 std::size_t pixel = static_cast<std::size_t>(j) * opt.width + i;
-                Vec3 c = tracer.trace(eye[pixel], RayKind::Eye, 1, nullptr);
+                Vec3 c = tracer.trace(eye(pixel), RayKind::Eye, 1, nullptr);
                 img.rgb[pixel * 3 + 0] = to_byte(c.x);
                 img.rgb[pixel * 3 + 1] = to_byte(c.y);
                 img.rgb[pixel * 3 + 2] = to_byte(c.z);

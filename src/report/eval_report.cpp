@@ -97,6 +97,7 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
             {"sample_rays", r.sample_rays},
             {"distribution_rays", r.distribution_rays},
             {"sample_seconds", r.sample_seconds},
+            {"sample_file", r.sample_file},
             {"visibility_rays", r.visibility_rays},
             {"visibility_seconds", r.visibility_seconds},
             {"split", r.split},
