@@ -390,10 +390,11 @@ TEST(Design, ControlTimesTheYardstickInASecondEvaluation) {
     EXPECT_NE(design_table(r).find("control: grid:res=hetero"), std::string::npos);
 }
 
-TEST(BvhDesign, BoxesMetFourAtATimeAsBoxEntryFindsThem) {
+TEST(BvhDesign, BoxesMetManyAtATimeAsBoxEntryFindsThem) {
     // Random boxes and segments, and the hard cases: zero direction components, origins in a
     // box's face plane, flat boxes, a box touching the segment's end, segments through the
-    // origin (where the padding boxes of the last four lie). Counted (count_met) as listed.
+    // origin and along an axis to infinity (beside the padding's empty boxes). Counted
+    // (count_met, with AVX2 where the CPU has it, and on the baseline instructions) as listed.
     std::mt19937 rng(3);
     std::uniform_real_distribution<float> u(-2, 2);
     std::vector<Box3> boxes;
@@ -408,7 +409,9 @@ TEST(BvhDesign, BoxesMetFourAtATimeAsBoxEntryFindsThem) {
     bvh::BoxColumns columns;
     columns.assign(boxes);
     ASSERT_EQ(columns.padded(), 16u);
-    std::vector<std::uint32_t> counts(columns.padded()), want_counts(columns.padded());
+    std::vector<bvh::Segment> segments;
+    std::vector<Ray> rays;
+    std::vector<std::uint32_t> want_counts(columns.padded());
     std::size_t met_total = 0, tested = 0;
     for (int r = 0; r < 4000; ++r) {
         Ray ray{{u(rng), u(rng), u(rng)}, {u(rng), u(rng), u(rng)}, 0, r % 3 ? kInf : std::fabs(u(rng))};
@@ -417,17 +420,37 @@ TEST(BvhDesign, BoxesMetFourAtATimeAsBoxEntryFindsThem) {
         if (r % 13 == 0) ray.o.x = 1;  // in a face plane of the unit box
         if (r % 17 == 0) ray.o = Vec3{0.5f, 0.5f, -1}, ray.d = Vec3{0, 0, 1}, ray.tmax = 1;  // ends at its face
         if (r % 19 == 0) ray.o = Vec3{0, 0, -1}, ray.d = Vec3{0, 0, 1}, ray.tmax = kInf;  // through the origin
+        if (r % 23 == 0) ray.d = Vec3{r % 2 ? -0.0f : 0.0f, 0, 1};  // a signed zero, to infinity
         const RayInv ri(ray);
+        rays.push_back(ray);
+        segments.emplace_back(ri, ray.tmin, ray.tmax);
         std::vector<char> want(boxes.size()), got(boxes.size());
         for (std::size_t j = 0; j < boxes.size(); ++j) want[j] = box_entry(boxes[j], ri, ray.tmin, ray.tmax) != kInf;
-        columns.each_met(ri, ray.tmin, ray.tmax, [&](std::size_t j) { got[j] = 1; });
+        columns.each_met(segments.back(), [&](std::size_t j) {
+            ASSERT_LT(j, boxes.size());
+            got[j] = 1;
+        });
         ASSERT_EQ(got, want) << "ray " << r;
-        columns.count_met(ri, ray.tmin, ray.tmax, counts.data());
         for (std::size_t j = 0; j < boxes.size(); ++j) want_counts[j] += want[j];
         for (char w : want) met_total += w;
         tested += boxes.size();
     }
+    // Every segment, and every third (a sparse list, as a node's).
+    std::vector<std::uint32_t> all(segments.size()), thirds, want_thirds(columns.padded());
+    for (std::uint32_t r = 0; r < all.size(); ++r) {
+        all[r] = r;
+        if (r % 3 == 0) thirds.push_back(r);
+    }
+    for (std::uint32_t r : thirds)
+        for (std::size_t j = 0; j < boxes.size(); ++j)
+            want_thirds[j] += box_entry(boxes[j], RayInv(rays[r]), rays[r].tmin, rays[r].tmax) != kInf;
+    std::vector<std::uint32_t> counts(columns.padded()), baseline(columns.padded()), sparse(columns.padded());
+    columns.count_met(all, segments.data(), counts.data());
+    columns.count_met_baseline(all, segments.data(), baseline.data());
+    columns.count_met(thirds, segments.data(), sparse.data());
     EXPECT_EQ(counts, want_counts);
+    EXPECT_EQ(baseline, want_counts);
+    EXPECT_EQ(sparse, want_thirds);
     // Both answers are common.
     EXPECT_GT(met_total, tested / 50);
     EXPECT_LT(met_total, tested * 9 / 10);

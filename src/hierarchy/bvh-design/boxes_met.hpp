@@ -1,9 +1,9 @@
 #pragma once
-// Which of a few boxes each sample segment meets: bvh-design weighs 10 candidate splits at every
-// node, two boxes each, against every sample segment reaching the node (with the binning of the
-// candidates, a third of its design time). Four boxes per ray at once with SSE here, decided
+// Which of a few boxes each sample segment meets: bvh-design weighs its candidate splits at every
+// node, two boxes each, against every sample segment reaching the node (a third of its design
+// time). Four or eight boxes per segment at once (SSE, or AVX2 where the CPU has it), decided
 // exactly as box_entry decides one (the same operations in the same order; max/min keep the
-// second operand on NaN as box_entry's compares do), so the design is the same tree.
+// second operand on NaN as box_entry's compares do), so the design is the same tree on any CPU.
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -16,108 +16,69 @@
 
 namespace rtcost::bvh {
 
-/// The boxes in four-wide columns: lo and hi per axis, padded to a multiple of four.
+/// A sample segment as the box tests read it: RayInv's origin, reciprocal and direction signs,
+/// and the part of the ray searched (from tmin to where its search ends).
+struct Segment {
+    float o[3], inv[3];
+    float t0, t1;
+    int neg[3];
+    Segment(const RayInv& ri, float tmin, float tmax)
+        : o{ri.o.x, ri.o.y, ri.o.z}, inv{ri.inv.x, ri.inv.y, ri.inv.z}, t0(tmin), t1(tmax),
+          neg{ri.neg[0], ri.neg[1], ri.neg[2]} {}
+};
+
+/// The boxes in columns: lo and hi per axis, padded to a multiple of eight with empty boxes,
+/// which no segment meets.
 class BoxColumns {
 public:
     /// Holds `boxes` (replacing any), reusing its storage: one per design, refilled per node.
-    void assign(std::span<const Box3> boxes) {
-        n_ = boxes.size();
-        padded_ = (n_ + 3) / 4 * 4;
-        for (int a = 0; a < 3; ++a) {
-            lo_[a].assign(padded_, 0.0f);
-            hi_[a].assign(padded_, 0.0f);
-        }
-        for (std::size_t j = 0; j < n_; ++j)
-            for (int a = 0; a < 3; ++a) {
-                lo_[a][j] = boxes[j].lo[a];
-                hi_[a][j] = boxes[j].hi[a];
-            }
-    }
+    void assign(std::span<const Box3> boxes);
 
-    /// Calls `met(j)` for every box j that box_entry(box j, ri, tmin, tmax) finds on the segment.
+    /// Calls `met(j)` for every box j that box_entry(box j, s's ray, s.t0, s.t1) finds.
     template <class Met>
-    void each_met(const RayInv& ri, float tmin, float tmax, Met&& met) const {
-        const Rows rows(*this, ri);
+    void each_met(const Segment& s, Met&& met) const {
         for (std::size_t j = 0; j < padded_; j += 4)
-            for (unsigned mask = met_bits(rows, j, ri, tmin, tmax); mask; mask &= mask - 1)
+            for (unsigned mask = met_bits(s, j); mask; mask &= mask - 1)
                 met(j + static_cast<std::size_t>(__builtin_ctz(mask)));
     }
 
-    /// Adds one to `counts[j]` for every box j that each_met would report; `counts` holds
-    /// padded() entries (the padding's stay 0).
-    void count_met(const RayInv& ri, float tmin, float tmax, std::uint32_t* counts) const {
-        const Rows rows(*this, ri);
-#if defined(__SSE2__)
-        // Four counts at once: a met lane is all ones, -1 as an integer (a tenth of the design
-        // time went to adding the four bits one by one).
-        for (std::size_t j = 0; j < padded_; j += 4) {
-            __m128i* at = reinterpret_cast<__m128i*>(counts + j);
-            _mm_storeu_si128(at, _mm_sub_epi32(_mm_loadu_si128(at), _mm_castps_si128(met_lanes(rows, j, ri, tmin, tmax))));
-        }
-#else
-        for (std::size_t j = 0; j < padded_; j += 4) {
-            const unsigned mask = met_bits(rows, j, ri, tmin, tmax);
-            for (int k = 0; k < 4; ++k) counts[j + k] += (mask >> k) & 1u;
-        }
-#endif
-    }
+    /// Adds to `counts[j]` how many of the segments `segments[r]`, r in `which`, each_met reports
+    /// box j for; `counts` holds padded() entries (the padding's stay 0).
+    void count_met(std::span<const std::uint32_t> which, const Segment* segments, std::uint32_t* counts) const;
+    /// count_met on the baseline instruction set alone (what a CPU without AVX2 runs).
+    void count_met_baseline(std::span<const std::uint32_t> which, const Segment* segments, std::uint32_t* counts) const;
 
-    /// The boxes' count rounded up to a multiple of four.
+    /// The boxes' count rounded up to a multiple of eight.
     std::size_t padded() const { return padded_; }
+    /// Axis `a`'s lower (or upper, `hi`) faces of the padded boxes.
+    const float* faces(int a, bool hi) const { return hi ? hi_[a].data() : lo_[a].data(); }
 
 private:
-    // Each axis's near and far planes for the ray's direction signs.
-    struct Rows {
-        const float* near[3];
-        const float* far[3];
-        Rows(const BoxColumns& c, const RayInv& ri) {
-            for (int a = 0; a < 3; ++a) {
-                near[a] = ri.neg[a] ? c.hi_[a].data() : c.lo_[a].data();
-                far[a] = ri.neg[a] ? c.lo_[a].data() : c.hi_[a].data();
-            }
-        }
-    };
-
+    // Bit k set when box j + k is met.
+    unsigned met_bits(const Segment& s, std::size_t j) const {
 #if defined(__SSE2__)
-    // Boxes j to j + 3: all ones in the lanes of the boxes met, zero in the others and in the
-    // padding's (a point at the origin, which a ray can meet).
-    __m128 met_lanes(const Rows& rows, std::size_t j, const RayInv& ri, float tmin, float tmax) const {
         const __m128 widen = _mm_set1_ps(1.0000004f), inf = _mm_set1_ps(kInf);
-        __m128 t0 = _mm_set1_ps(tmin), t1 = _mm_set1_ps(tmax);
+        __m128 t0 = _mm_set1_ps(s.t0), t1 = _mm_set1_ps(s.t1);
         for (int a = 0; a < 3; ++a) {
-            const __m128 o = _mm_set1_ps(ri.o[a]), inv = _mm_set1_ps(ri.inv[a]);
-            const __m128 tn = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(rows.near[a] + j), o), inv);
-            const __m128 tf = _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(rows.far[a] + j), o), inv), widen);
+            const __m128 o = _mm_set1_ps(s.o[a]), inv = _mm_set1_ps(s.inv[a]);
+            const __m128 tn = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(faces(a, s.neg[a]) + j), o), inv);
+            const __m128 tf = _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(faces(a, !s.neg[a]) + j), o), inv), widen);
             t0 = _mm_max_ps(tn, t0);  // tn > t0 ? tn : t0
             t1 = _mm_min_ps(tf, t1);  // tf < t1 ? tf : t1
         }
-        // box_entry returns t0 when t0 <= t1 (else +inf), and a box is met when that is finite.
-        __m128 met = _mm_and_ps(_mm_cmple_ps(t0, t1), _mm_cmplt_ps(t0, inf));
-        if (j + 4 > n_) {
-            alignas(16) static constexpr std::int32_t kKeep[4][4] = {{0, 0, 0, 0}, {-1, 0, 0, 0}, {-1, -1, 0, 0}, {-1, -1, -1, 0}};
-            met = _mm_and_ps(met, _mm_load_ps(reinterpret_cast<const float*>(kKeep[n_ - j])));
-        }
-        return met;
-    }
-#endif
-
-    // met_lanes as four bits, bit k for box j + k.
-    unsigned met_bits(const Rows& rows, std::size_t j, const RayInv& ri, float tmin, float tmax) const {
-#if defined(__SSE2__)
-        return static_cast<unsigned>(_mm_movemask_ps(met_lanes(rows, j, ri, tmin, tmax)));
+        return static_cast<unsigned>(_mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(t0, t1), _mm_cmplt_ps(t0, inf))));
 #else
         unsigned mask = 0;
         for (std::size_t k = 0; k < 4; ++k) {
-            float t0 = tmin, t1 = tmax;
+            float t0 = s.t0, t1 = s.t1;
             for (int a = 0; a < 3; ++a) {
-                const float tn = (rows.near[a][j + k] - ri.o[a]) * ri.inv[a];
-                const float tf = (rows.far[a][j + k] - ri.o[a]) * ri.inv[a] * 1.0000004f;
+                const float tn = (faces(a, s.neg[a])[j + k] - s.o[a]) * s.inv[a];
+                const float tf = (faces(a, !s.neg[a])[j + k] - s.o[a]) * s.inv[a] * 1.0000004f;
                 t0 = tn > t0 ? tn : t0;
                 t1 = tf < t1 ? tf : t1;
             }
             if (t0 <= t1 && t0 != kInf) mask |= 1u << k;
         }
-        if (j + 4 > n_) mask &= (1u << (n_ - j)) - 1;
         return mask;
 #endif
     }

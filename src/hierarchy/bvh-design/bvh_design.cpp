@@ -50,13 +50,13 @@ std::optional<AxisOrders> root_orders(const Scene& s, const DesignOptions& o, co
 BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions& o, const PrimInfo& info,
                      const std::optional<AxisOrders>& root) {
     const RaySample& smp = in.sample;
-    std::vector<RayInv> inv;
-    inv.reserve(smp.size());
-    for (std::size_t i = 0; i < smp.size(); ++i) inv.emplace_back(smp.rays.rays[i]);
-    auto meets = [&](std::uint32_t r, const Box3& b) {
-        const Ray& ray = smp.rays.rays[r];
-        return box_entry(b, inv[r], ray.tmin, std::min(ray.tmax, smp.t_end[r])) != kInf;
-    };
+    // Each sample ray's segment: from tmin to where its search ends.
+    std::vector<Segment> segments;
+    segments.reserve(smp.size());
+    for (std::size_t i = 0; i < smp.size(); ++i) {
+        const Ray& ray = smp.rays.rays[i];
+        segments.emplace_back(RayInv(ray), ray.tmin, std::min(ray.tmax, smp.t_end[i]));
+    }
     // Mean cost of a primitive test and of a binary node's visit (a step and two box tests), in the
     // costs' units.
     double prim_cost = 0;
@@ -75,8 +75,13 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
         std::vector<std::uint32_t> rays[2];
     };
     std::vector<Reaching> reaching(static_cast<std::size_t>(o.max_depth) + 2);
-    for (std::uint32_t r = 0; r < smp.size(); ++r)
-        if (meets(r, s.bounds())) reaching[0].rays[0].push_back(r);
+    {
+        const Box3 root_box[1] = {s.bounds()};
+        BoxColumns root;
+        root.assign(root_box);
+        for (std::uint32_t r = 0; r < smp.size(); ++r)
+            root.each_met(segments[r], [&](std::size_t) { reaching[0].rays[0].push_back(r); });
+    }
     // Reused from node to node: the candidates' boxes and how many segments meet each.
     std::vector<Box3> boxes;
     BoxColumns columns;
@@ -116,17 +121,15 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
         int chosen = -1;
         const int k = w == 0 ? std::min<int>(1, static_cast<int>(cuts.size())) : static_cast<int>(cuts.size());
         // How many segments meet each candidate's left and right box (met[2c], met[2c + 1]), as
-        // meets() finds them, all boxes of a ray at once. Only the chosen cut's segments are
-        // listed, below: listing every candidate's took a fifth of the design time.
+        // box_entry finds them on the segments, every box of a segment at once (boxes_met.hpp).
+        // Only the chosen cut's segments are listed, below: listing every candidate's took a fifth
+        // of the design time.
         if (w > 0) {
             boxes.clear();
             for (int c = 0; c < k; ++c) boxes.insert(boxes.end(), {cuts[c].left, cuts[c].right});
             columns.assign(boxes);
             met.assign(columns.padded(), 0);
-            for (std::uint32_t r : rays) {
-                const Ray& ray = smp.rays.rays[r];
-                columns.count_met(inv[r], ray.tmin, std::min(ray.tmax, smp.t_end[r]), met.data());
-            }
+            columns.count_met(rays, segments.data(), met.data());
         }
         for (int c = 0; c < k; ++c) {
             const Cut& cut = cuts[c];
@@ -152,11 +155,8 @@ BvhData build_design(const Scene& s, const DesignInput& in, const DesignOptions&
         if (w > 0 && chosen >= 0) {
             const Box3 pair[2] = {cuts[chosen].left, cuts[chosen].right};
             columns.assign(pair);
-            for (std::uint32_t r : rays) {
-                const Ray& ray = smp.rays.rays[r];
-                columns.each_met(inv[r], ray.tmin, std::min(ray.tmax, smp.t_end[r]),
-                                 [&](std::size_t j) { (j == 0 ? best_left : best_right).push_back(r); });
-            }
+            for (std::uint32_t r : rays)
+                columns.each_met(segments[r], [&](std::size_t j) { (j == 0 ? best_left : best_right).push_back(r); });
         }
         std::uint32_t mid;
         if (chosen < 0) {
