@@ -192,6 +192,70 @@ TEST(GridStructure, ReferencesGoToEveryCellTheBoundsTouch) {
     }
 }
 
+TEST(GridStructure, CellsOfAPrimitiveAreThoseItsBoundsReachOnThePlanes) {
+    // Odd resolutions (boundaries rounded from double), and triangles whose box faces lie exactly
+    // on a boundary, just either side of it, or flat: every cell lists exactly the primitives whose
+    // box reaches it by the planes themselves, as the binary searches over them decide (the
+    // first cell whose upper boundary is >= the box's lo, through the last whose lower boundary
+    // is <= its hi).
+    std::mt19937 rng(11);
+    std::uniform_real_distribution<float> u(-3.7f, 5.3f);
+    Scene s;
+    s.add(Triangle{{-3.7f, -3.7f, -3.7f}, {5.3f, -3.7f, -3.7f}, {5.3f, 5.3f, 5.3f}}, 0);  // the scene's box
+    s.finalize();
+    const std::array<int, 3> res{7, 5, 9};
+    std::vector<std::vector<float>> on_planes;  // each axis's boundaries, from a first grid
+    {
+        const Grid first(s, res, spatial::Assign::Bounds, false);
+        for (int a = 0; a < 3; ++a) on_planes.emplace_back(first.planes(a).begin(), first.planes(a).end());
+    }
+    auto plane = [&](int a, int n) { return on_planes[a][static_cast<std::size_t>(n) % on_planes[a].size()]; };
+    for (int n = 0; n < 800; ++n) {
+        Vec3 p[3];
+        const Vec3 c{u(rng), u(rng), u(rng)};
+        // Inside the first triangle's box, so that every grid here has the same planes.
+        auto in_box = [](float x) { return std::clamp(x, -3.7f, 5.3f); };
+        for (Vec3& v : p) v = Vec3{c.x + 0.2f * u(rng), c.y + 0.2f * u(rng), c.z + 0.2f * u(rng)};
+        if (n % 3 == 0) p[0].x = plane(0, n), p[1].x = std::nextafter(p[0].x, 10.0f);
+        if (n % 5 == 0) p[1].y = plane(1, n), p[2].y = std::nextafter(p[1].y, -10.0f);
+        if (n % 7 == 0) p[0].z = p[1].z = p[2].z = plane(2, n);  // flat, on a boundary
+        if (n % 11 == 0) p[0].x = p[1].x = p[2].x = std::nextafter(plane(0, n), -10.0f);  // flat, just below one
+        if (n % 13 == 0) {  // lowest just above a boundary, on every axis
+            for (int a = 0; a < 3; ++a) {
+                const float lo = std::nextafter(plane(a, n + a), 10.0f);
+                p[0][a] = lo, p[1][a] = lo + 0.1f, p[2][a] = lo + 0.05f;
+            }
+        }
+        for (Vec3& v : p) v = Vec3{in_box(v.x), in_box(v.y), in_box(v.z)};
+        s.add(Triangle{p[0], p[1], p[2]}, 0);
+    }
+    s.finalize();
+    const Grid g(s, res, spatial::Assign::Bounds, false);
+    ASSERT_EQ(g.res(), res);
+    for (int a = 0; a < 3; ++a) ASSERT_EQ(std::vector<float>(g.planes(a).begin(), g.planes(a).end()), on_planes[a]);
+    std::size_t listed = 0;
+    for (std::uint32_t id = 0; id < s.size(); ++id) {
+        const Box3 b = s.prim_bounds(id);
+        int lo[3], hi[3];
+        for (int a = 0; a < 3; ++a) {
+            const std::span<const float> pl = g.planes(a);
+            lo[a] = std::min(static_cast<int>(std::lower_bound(pl.begin() + 1, pl.end(), b.lo[a]) - (pl.begin() + 1)), res[a] - 1);
+            hi[a] = std::max(static_cast<int>(std::upper_bound(pl.begin(), pl.end() - 1, b.hi[a]) - pl.begin()) - 1, 0);
+        }
+        for (int k = 0; k < res[2]; ++k)
+            for (int j = 0; j < res[1]; ++j)
+                for (int i = 0; i < res[0]; ++i) {
+                    const auto c = g.cell(i, j, k);
+                    const bool in = std::binary_search(c.begin(), c.end(), id);
+                    const bool want = lo[0] <= i && i <= hi[0] && lo[1] <= j && j <= hi[1] && lo[2] <= k && k <= hi[2];
+                    ASSERT_EQ(in, want) << "primitive " << id << " cell " << i << "," << j << "," << k;
+                    listed += in;
+                }
+    }
+    EXPECT_EQ(listed, g.structure().references);
+    EXPECT_GT(listed, 2 * s.size());  // many primitives span cells
+}
+
 TEST(GridStructure, ExactAssignmentSkipsCellsInsideABigSphere) {
     // A sphere of radius 2 centred in [0,4]^3: its box touches all 64 cells, its surface misses
     // the 8 central cells [1,3]^3 (their farthest corner is sqrt(3) < 2 from the centre) and

@@ -12,18 +12,23 @@
 namespace rtcost::grid {
 
 std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, spatial::Assign assign, bool mailbox,
-                                         std::uint64_t max_cells) {
+                                         std::uint64_t max_cells, std::unique_ptr<Grid>* cheapest) {
     std::map<std::array<int, 3>, double> seen;
     const Box3 box = s.bounds();
     const designing::SampleReplay replay(s, in.sample, in.costs);
+    const std::vector<Box3> bounds = all_prim_bounds(s);  // once for every candidate
+    // The cheapest grid built so far, kept rather than built again at the end.
+    std::unique_ptr<Grid> kept;
+    double kept_cost = kInf;
     auto cost = [&](std::array<int, 3> r) -> double {
         for (int a = 0; a < 3; ++a) r[a] = std::clamp(r[a], 1, kMaxRes);
         if (auto it = seen.find(r); it != seen.end()) return it->second;
         const std::uint64_t cells = std::uint64_t(r[0]) * r[1] * r[2];
         double c = kInf;
         if (cells <= max_cells) {
-            const Grid g(s, r, assign, mailbox);
-            c = replay.time(g);
+            auto g = std::make_unique<Grid>(s, r, assign, mailbox, bounds);
+            c = replay.time(*g);
+            if (cheapest && c < kept_cost) kept = std::move(g), kept_cost = c;
         }
         seen[r] = c;
         return c;
@@ -77,6 +82,8 @@ std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, 
         if (cx != cy) return cx < cy;
         return x.res < y.res;
     });
+    // The cheapest first: the grid kept unless a tie put another resolution first.
+    if (cheapest) *cheapest = kept && kept->res() == out.front().res ? std::move(kept) : nullptr;
     return out;
 }
 
@@ -103,8 +110,9 @@ const Registration reg{
          const double md = p.real("max_density");
          const auto max_cells =
              std::min<std::uint64_t>(kMaxCells, static_cast<std::uint64_t>(std::max(1.0, md * static_cast<double>(s.size()))) + 64);
-         std::vector<Candidate> tried = search_resolution(s, in, assign, mailbox, max_cells);
-         auto g = std::make_unique<Grid>(s, tried.front().res, assign, mailbox);
+         std::unique_ptr<Grid> g;
+         std::vector<Candidate> tried = search_resolution(s, in, assign, mailbox, max_cells, &g);
+         if (!g) g = std::make_unique<Grid>(s, tried.front().res, assign, mailbox);
          return std::make_unique<GridDesign>(s, std::move(g), std::move(tried));
      },
      kLargeScene}};  // each candidate grid's model tree holds two nodes per cell: minutes for a million

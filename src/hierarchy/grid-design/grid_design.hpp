@@ -22,9 +22,10 @@ struct Candidate {
 /// The search: the hetero formula's cell shape from 1 cell per primitive, doubled (up to 64) or
 /// else halved (down to 1/8) while the cost falls, then
 /// coordinate descent on each axis (factors 3/4 and 4/3) from the cheapest, until no step
-/// pays. At most `max_cells` cells per candidate. Returns every candidate, cheapest first.
+/// pays. At most `max_cells` cells per candidate. Returns every candidate, cheapest first, and
+/// in `*cheapest` (when given) the first one's grid, as built in the search (or null).
 std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, spatial::Assign assign, bool mailbox,
-                                         std::uint64_t max_cells);
+                                         std::uint64_t max_cells, std::unique_ptr<Grid>* cheapest = nullptr);
 
 class GridDesign final : public HierarchyImpl<GridDesign> {
 public:

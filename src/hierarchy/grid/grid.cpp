@@ -6,6 +6,7 @@
 #include <charconv>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include <fmt/format.h>
 
@@ -114,13 +115,23 @@ std::array<int, 3> resolution(std::string_view spec, double density, std::size_t
     return clamp_res(v);
 }
 
+std::vector<Box3> all_prim_bounds(const Scene& s) {
+    std::vector<Box3> out(s.size());
+    for (std::uint32_t id = 0; id < s.size(); ++id) out[id] = s.prim_bounds(id);
+    return out;
+}
+
 Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox)
+    : Grid(s, res, assign, mailbox, all_prim_bounds(s)) {}
+
+Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox, std::span<const Box3> bounds)
     : HierarchyImpl(s), box_(s.bounds()), empty_(s.empty() || s.bounds().empty()), res_(res), mailbox_(mailbox) {
+    if (bounds.size() != s.size()) throw std::logic_error("grid: primitive bounds of another scene");
     if (empty_) {
         res_ = {1, 1, 1};
         box_ = Box3{{0, 0, 0}, {0, 0, 0}};
     } else {
-        limit_references(s);
+        limit_references(bounds);
     }
     // Boundaries in double, rounded once: non-decreasing, first and last exactly the box faces.
     for (int a = 0; a < 3; ++a) {
@@ -137,16 +148,28 @@ Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool 
     // Every cell each primitive's box overlaps (closed intervals), primitives in id order: from
     // the first cell whose upper boundary reaches the box's lo to the last whose lower boundary
     // is <= its hi.
+    // On each axis: lo, the first cell whose upper boundary is >= the box's lo (the last cell if
+    // none is), and hi, the last cell whose lower boundary is <= its hi (the first if none is),
+    // found from guess() by stepping along the planes (a cell or two at most) rather than by a
+    // binary search over them, which was most of a grid's build (a grid-design search builds a
+    // score of grids). The same cells as lower_bound and upper_bound find, NaN included.
     auto each_overlap = [&](auto&& f) {
         for (std::uint32_t id = 0; id < s.size(); ++id) {
-            const Box3 pb = s.prim_bounds(id);
+            const Box3& pb = bounds[id];
             if (pb.empty()) continue;
             int lo[3], hi[3];
             for (int a = 0; a < 3; ++a) {
                 const float* pl = planes_[a].data();
                 const int r = res_[a];
-                lo[a] = std::min(static_cast<int>(std::lower_bound(pl + 1, pl + r + 1, pb.lo[a]) - (pl + 1)), r - 1);
-                hi[a] = std::max(static_cast<int>(std::upper_bound(pl, pl + r, pb.hi[a]) - pl) - 1, 0);
+                const float v0 = pb.lo[a], v1 = pb.hi[a];
+                int i = guess(a, v0);
+                while (i > 0 && !(pl[i] < v0)) --i;
+                while (i < r - 1 && pl[i + 1] < v0) ++i;
+                lo[a] = i;
+                i = guess(a, v1);
+                while (i > 0 && v1 < pl[i]) --i;
+                while (i < r - 1 && !(v1 < pl[i + 1])) ++i;
+                hi[a] = i;
             }
             for (int k = lo[2]; k <= hi[2]; ++k)
                 for (int j = lo[1]; j <= hi[1]; ++j)
@@ -200,7 +223,8 @@ Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool 
 // crossing at most rx + ry + rz cells of average occupancy must not expect more than
 // kTestsPerPrim times the N tests of brute force (nor kMinTests, for a handful of primitives). The resolution is reduced, all axes alike,
 // until both hold; no SPD scene comes near either at the default density.
-void Grid::limit_references(const Scene& s) {
+void Grid::limit_references(std::span<const Box3> bounds) {
+    const Scene& s = *scene_;
     const std::uint64_t memory = std::max<std::uint64_t>(kMinRefBudget, kRefsPerPrim * s.size());
     auto budget = [&](const std::array<int, 3>& r) {
         const double tests = std::max(double(kTestsPerPrim) * double(s.size()), double(kMinTests));
@@ -210,7 +234,7 @@ void Grid::limit_references(const Scene& s) {
     auto count = [&](const std::array<int, 3>& r, double limit) {
         double total = 0;
         for (std::uint32_t id = 0; id < s.size() && total <= limit; ++id) {
-            const Box3 pb = s.prim_bounds(id);
+            const Box3& pb = bounds[id];
             double n = 1;
             for (int a = 0; a < 3; ++a) {
                 const double ext = double(box_.hi[a]) - box_.lo[a];

@@ -38,9 +38,15 @@ inline constexpr double kFlat = 1e-6;
 /// naming `res` for a bad spec.
 std::array<int, 3> resolution(std::string_view spec, double density, std::size_t n, const Box3& box);
 
+/// Every primitive's bounds, by id (Scene::prim_bounds).
+std::vector<Box3> all_prim_bounds(const Scene& s);
+
 class Grid final : public HierarchyImpl<Grid> {
 public:
     Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox);
+    /// The same grid from the primitives' bounds, `bounds[id] = s.prim_bounds(id)`, computed
+    /// once for the several grids of a search.
+    Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox, std::span<const Box3> bounds);
 
     std::string_view name() const override { return "grid"; }
     bool emit_model(ModelSink& sink) const override;
@@ -85,7 +91,7 @@ private:
     /// Expected primitive tests per ray, in units of the primitive count, before the
     /// resolution is reduced; see limit_references.
     static constexpr int kTestsPerPrim = 2, kMinTests = 64;
-    void limit_references(const Scene& s);
+    void limit_references(std::span<const Box3> bounds);
     std::vector<std::string> limits_;
 
     std::uint64_t cell_index(int i, int j, int k) const {
