@@ -1,6 +1,8 @@
 // The designs price a built candidate by its own traversal of the design sample, each primitive
 // test answered from the rays' known crossings (design/replay.hpp): it must be the model's
 // prediction through the candidate's model tree (sample_cost), for every structure priced so.
+#include <random>
+
 #include "../src/design/replay.hpp"
 #include "../src/hierarchy/bsp/bsp.hpp"
 #include "../src/hierarchy/bvh-design/occlusion_order.hpp"
@@ -66,6 +68,40 @@ std::string variant_name(const Variant& v) {
 constexpr double kExact = 1e-6;
 
 // grid-design's candidates, by the grid's 3DDDA.
+TEST(Replay, KnownCrossingsFilterAnswersAsTheScan) {
+    // Lists of 0 to 80 crossings (more than the filter's 256 buckets hold apart once past a few
+    // dozen), ids close together and far apart, a repeated id; every id asked for, with the hit so
+    // far and tmax before, at and beyond each crossing.
+    std::mt19937 rng(5);
+    std::size_t crossed = 0, asked = 0;
+    for (int trial = 0; trial < 300; ++trial) {
+        std::vector<Crossing> list;
+        const int n = trial % 81;
+        std::uniform_int_distribution<std::uint32_t> id(0, trial % 2 ? 300 : 4000000000u);
+        for (int k = 0; k < n; ++k) list.push_back({id(rng), 0.5f + static_cast<float>(k)});
+        if (n > 2) list.push_back(list[1]);  // a repeat: the first is the answer
+        const model::KnownCrossings known(list);
+        std::vector<std::uint32_t> ids;
+        for (const Crossing& c : list) ids.push_back(c.prim), ids.push_back(c.prim + 1);
+        for (int k = 0; k < 200; ++k) ids.push_back(id(rng));
+        for (std::uint32_t q : ids)
+            for (float bound : {0.25f, 3.5f, 40.0f, kInf}) {
+                const Ray ray{{0, 0, 0}, {0, 0, 1}, 0, trial % 3 ? kInf : bound};
+                Hit want, got;
+                want.t = got.t = trial % 3 ? bound : kInf;
+                const bool w = model::known_crossing_hit(list, q, ray, want);
+                ASSERT_EQ(known.hit(q, ray, got), w) << "trial " << trial << " id " << q;
+                ASSERT_EQ(got.t, want.t);
+                ASSERT_EQ(got.prim, want.prim);
+                crossed += w;
+                ++asked;
+            }
+    }
+    // Both answers are common.
+    EXPECT_GT(crossed, asked / 20);
+    EXPECT_LT(crossed, asked / 2);
+}
+
 TEST(Replay, OfAGridIsTheModelTreesPrediction) {
     int fewer_with_mailboxes = 0;
     const int samples = for_each_sample(

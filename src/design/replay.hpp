@@ -59,7 +59,7 @@ public:
         for (std::size_t i = 0; i < sample_.size(); ++i) {
             const Query q = sample_.queries[i];
             if (which != Rays::All && (q == Query::Any) != (which == Rays::Occlusion)) continue;
-            const KnownTest test{sample_.crossings_of(i), kinds_.data(), scene_};
+            const KnownTest test{model::KnownCrossings(sample_.crossings_of(i)), kinds_.data(), scene_};
             const Ray& ray = sample_.rays.rays[i];
             Hit hit;
             switch (q) {

@@ -135,6 +135,34 @@ inline bool known_crossing_hit(std::span<const Crossing> known, std::uint32_t id
     return false;
 }
 
+/// A ray's known crossings (nearest first) with a 256-bit filter of their primitives: a test of
+/// a primitive the ray does not cross (most tests) is answered from the filter, without a scan of
+/// the list (on shells' camera rays, through nested spheres, the scan was two thirds of every
+/// replay). The same answers as known_crossing_hit.
+class KnownCrossings {
+public:
+    KnownCrossings() = default;
+    explicit KnownCrossings(std::span<const Crossing> known) : known_(known) {
+        for (const Crossing& x : known) {
+            const unsigned b = bucket(x.prim);
+            filter_[b >> 6] |= std::uint64_t{1} << (b & 63);
+        }
+    }
+    /// known_crossing_hit(list(), id, ray, hit).
+    bool hit(std::uint32_t id, const Ray& ray, Hit& hit) const {
+        const unsigned b = bucket(id);
+        if (!((filter_[b >> 6] >> (b & 63)) & 1)) return false;
+        return known_crossing_hit(known_, id, ray, hit);
+    }
+    std::span<const Crossing> list() const { return known_; }
+
+private:
+    // Fibonacci hashing: the top 8 bits of the id times 2^32 / phi, which spreads neighbouring ids.
+    static unsigned bucket(std::uint32_t id) { return (id * 0x9E3779B1u) >> 24; }
+    std::span<const Crossing> known_;
+    std::uint64_t filter_[4] = {0, 0, 0, 0};
+};
+
 /// Each node's parent and traversal depth (the number of its ancestors that are steps), for the
 /// sampled estimator's recursion over a materialised tree.
 struct Walk {

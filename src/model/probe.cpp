@@ -29,22 +29,22 @@ public:
     }
     /// Ray `i` of the probe's rays starts.
     void begin(std::size_t i) {
-        if (sample_) known_ = sample_->crossings_of(index_[i]);
+        if (sample_) known_ = KnownCrossings(sample_->crossings_of(index_[i]));
     }
     void end() { known_ = {}; }
     /// test_prim's answer: records a hit nearer than `hit.t`.
     bool test(std::uint32_t id, const Ray& ray, Hit& hit) {
         if (!sample_) return test_prim(s_, id, ray, hit, nc_);
-        // A ray's crossings are a few (at most kMaxCrossings): a scan beats a table over the
-        // scene's primitives, which cost a pass over the scene per prediction.
-        return known_crossing_hit(known_, id, ray, hit);
+        // A ray's crossings are a few (at most kMaxCrossings): a filter and a scan beat a table
+        // over the scene's primitives, which cost a pass over the scene per prediction.
+        return known_.hit(id, ray, hit);
     }
 
 private:
     const Scene& s_;
     const RaySample* sample_ = nullptr;
     std::span<const std::uint32_t> index_;
-    std::span<const Crossing> known_;  // the current ray's crossings
+    KnownCrossings known_;  // the current ray's crossings
     NoCount nc_;
 };
 

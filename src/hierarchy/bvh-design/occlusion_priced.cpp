@@ -49,7 +49,7 @@ void price_occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sam
     };
     const Ray* ray = nullptr;
     RayInv ri(Ray{});
-    std::span<const Crossing> known;
+    model::KnownCrossings known;
     // The subtree of `node` walked by the ray (every child it meets, the orders as they are).
     auto walk = [&](auto&& self, std::uint32_t node) -> Walked {
         const Node& n = d.nodes[node];
@@ -59,7 +59,7 @@ void price_occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sam
                 c += prim_cost[k];
                 if (polygon[k]) c += costs.polygon_edge * s.edges_walked(d.refs[k], *ray);
                 Hit hit;
-                if (model::known_crossing_hit(known, d.refs[k], *ray, hit)) return {c, true};
+                if (known.hit(d.refs[k], *ray, hit)) return {c, true};
             }
             return {c, false};
         }
@@ -87,7 +87,7 @@ void price_occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sam
         for (std::uint32_t r : rays) {
             ray = &sample.rays.rays[r];
             ri = RayInv(*ray);
-            known = sample.crossings_of(r);
+            known = model::KnownCrossings(sample.crossings_of(r));
             if (box_entry(d.nodes[0].box, ri, ray->tmin, ray->tmax) != kInf) walk(walk, 0);
         }
         bool changed = false;

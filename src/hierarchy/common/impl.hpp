@@ -140,7 +140,7 @@ private:
 /// counts a real test. A traversal that takes it replays a sample ray as the model's probe
 /// replays it through the hierarchy's model tree (tests/test_replay.cpp).
 struct KnownTest {
-    std::span<const Crossing> known;
+    model::KnownCrossings known;
     /// Each primitive's PrimKind as a byte, or null to read the scene's (its records are far
     /// larger, and a replay looks up a kind for every reference of every leaf it visits).
     const std::uint8_t* kinds;
@@ -149,7 +149,7 @@ struct KnownTest {
         const auto kind = kinds ? static_cast<PrimKind>(kinds[id]) : scene.kind(id);
         c.prim(kind);
         if (kind == PrimKind::Polygon) c.edges(scene.edges_walked(id, up_to_hit(ray, hit)));
-        return model::known_crossing_hit(known, id, ray, hit);
+        return known.hit(id, ray, hit);
     }
     /// A traversal of a tree built only where the sample reaches (subdiv::CellOptions::reached)
     /// entered a cell left unbuilt: its count would be wrong.
@@ -168,7 +168,7 @@ bool HierarchyImpl<Derived>::replay(const RaySample& sample, std::span<const std
         Count counting{counters};
         for (std::uint32_t i : rays) {
             const Ray& ray = sample.rays.rays.at(i);  // (a bad index throws before its crossings are read)
-            const KnownTest test{sample.crossings_of(i), nullptr, *scene_};
+            const KnownTest test{model::KnownCrossings(sample.crossings_of(i)), nullptr, *scene_};
             Hit hit;
             ++counters.rays;
             switch (query) {

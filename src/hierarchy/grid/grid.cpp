@@ -232,16 +232,24 @@ void Grid::limit_references(std::span<const Box3> bounds) {
         return std::min<double>(double(memory), time);
     };
     auto count = [&](const std::array<int, 3>& r, double limit) {
+        // Per axis, once per count rather than per primitive (a division each).
+        bool cut[3];
+        double base[3], f[3], top[3];
+        for (int a = 0; a < 3; ++a) {
+            const double ext = double(box_.hi[a]) - box_.lo[a];
+            cut[a] = ext > 0 && r[a] != 1;
+            base[a] = box_.lo[a];
+            f[a] = cut[a] ? r[a] / ext : 0;
+            top[a] = r[a] - 1.0;
+        }
         double total = 0;
         for (std::uint32_t id = 0; id < s.size() && total <= limit; ++id) {
             const Box3& pb = bounds[id];
             double n = 1;
             for (int a = 0; a < 3; ++a) {
-                const double ext = double(box_.hi[a]) - box_.lo[a];
-                if (!(ext > 0) || r[a] == 1) continue;
-                const double f = r[a] / ext;
-                const double lo = std::clamp(std::floor((pb.lo[a] - double(box_.lo[a])) * f), 0.0, r[a] - 1.0);
-                const double hi = std::clamp(std::floor((pb.hi[a] - double(box_.lo[a])) * f), 0.0, r[a] - 1.0);
+                if (!cut[a]) continue;
+                const double lo = std::clamp(std::floor((pb.lo[a] - base[a]) * f[a]), 0.0, top[a]);
+                const double hi = std::clamp(std::floor((pb.hi[a] - base[a]) * f[a]), 0.0, top[a]);
                 n *= hi - lo + 1;
             }
             total += n;
