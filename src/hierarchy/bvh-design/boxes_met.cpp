@@ -3,6 +3,8 @@
 // with AVX2 where the CPU has it (the same operations lane by lane, so the same counts).
 #include "boxes_met.hpp"
 
+#include "util/cpu.hpp"
+
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
 #include <immintrin.h>
 #define RTCOST_BOXES_MET_AVX2 1
@@ -28,26 +30,12 @@ void BoxColumns::assign(std::span<const Box3> boxes) {
 void BoxColumns::count_met_baseline(std::span<const std::uint32_t> which, const Segment* segments,
                                     std::uint32_t* counts) const {
 #if defined(__SSE2__)
-    const __m128 widen = _mm_set1_ps(1.0000004f), inf = _mm_set1_ps(kInf);
     for (std::uint32_t r : which) {
-        const Segment& s = segments[r];
-        const __m128 o[3] = {_mm_set1_ps(s.o[0]), _mm_set1_ps(s.o[1]), _mm_set1_ps(s.o[2])};
-        const __m128 inv[3] = {_mm_set1_ps(s.inv[0]), _mm_set1_ps(s.inv[1]), _mm_set1_ps(s.inv[2])};
-        const float* near[3] = {faces(0, s.neg[0]), faces(1, s.neg[1]), faces(2, s.neg[2])};
-        const float* far[3] = {faces(0, !s.neg[0]), faces(1, !s.neg[1]), faces(2, !s.neg[2])};
-        const __m128 start = _mm_set1_ps(s.t0), end = _mm_set1_ps(s.t1);
+        const Lanes lanes(*this, segments[r]);
+        // A met lane is all ones, -1 as an integer: four counts at once.
         for (std::size_t j = 0; j < padded_; j += 4) {
-            __m128 t0 = start, t1 = end;
-            for (int a = 0; a < 3; ++a) {
-                const __m128 tn = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(near[a] + j), o[a]), inv[a]);
-                const __m128 tf = _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(far[a] + j), o[a]), inv[a]), widen);
-                t0 = _mm_max_ps(tn, t0);  // tn > t0 ? tn : t0
-                t1 = _mm_min_ps(tf, t1);  // tf < t1 ? tf : t1
-            }
-            // A met lane is all ones, -1 as an integer: four counts at once.
-            const __m128 met = _mm_and_ps(_mm_cmple_ps(t0, t1), _mm_cmplt_ps(t0, inf));
             __m128i* at = reinterpret_cast<__m128i*>(counts + j);
-            _mm_storeu_si128(at, _mm_sub_epi32(_mm_loadu_si128(at), _mm_castps_si128(met)));
+            _mm_storeu_si128(at, _mm_sub_epi32(_mm_loadu_si128(at), _mm_castps_si128(lanes.met(j))));
         }
     }
 #else
@@ -104,12 +92,6 @@ void count_met_avx2(std::size_t padded, const float* const lo[3], const float* c
 #pragma GCC pop_options
 #endif
 
-namespace {
-bool cpu_has_avx2() {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2");
-}
-}  // namespace
 #endif
 
 void BoxColumns::count_met(std::span<const std::uint32_t> which, const Segment* segments, std::uint32_t* counts) const {

@@ -37,8 +37,9 @@ public:
     /// Calls `met(j)` for every box j that box_entry(box j, s's ray, s.t0, s.t1) finds.
     template <class Met>
     void each_met(const Segment& s, Met&& met) const {
+        const Lanes lanes(*this, s);
         for (std::size_t j = 0; j < padded_; j += 4)
-            for (unsigned mask = met_bits(s, j); mask; mask &= mask - 1)
+            for (unsigned mask = lanes.met_bits(j); mask; mask &= mask - 1)
                 met(j + static_cast<std::size_t>(__builtin_ctz(mask)));
     }
 
@@ -54,34 +55,54 @@ public:
     const float* faces(int a, bool hi) const { return hi ? hi_[a].data() : lo_[a].data(); }
 
 private:
-    // Bit k set when box j + k is met.
-    unsigned met_bits(const Segment& s, std::size_t j) const {
+    // One segment against the boxes four at a time, its values broadcast once for all of them.
+    struct Lanes {
+        const float* near[3];
+        const float* far[3];
 #if defined(__SSE2__)
-        const __m128 widen = _mm_set1_ps(1.0000004f), inf = _mm_set1_ps(kInf);
-        __m128 t0 = _mm_set1_ps(s.t0), t1 = _mm_set1_ps(s.t1);
-        for (int a = 0; a < 3; ++a) {
-            const __m128 o = _mm_set1_ps(s.o[a]), inv = _mm_set1_ps(s.inv[a]);
-            const __m128 tn = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(faces(a, s.neg[a]) + j), o), inv);
-            const __m128 tf = _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(faces(a, !s.neg[a]) + j), o), inv), widen);
-            t0 = _mm_max_ps(tn, t0);  // tn > t0 ? tn : t0
-            t1 = _mm_min_ps(tf, t1);  // tf < t1 ? tf : t1
-        }
-        return static_cast<unsigned>(_mm_movemask_ps(_mm_and_ps(_mm_cmple_ps(t0, t1), _mm_cmplt_ps(t0, inf))));
-#else
-        unsigned mask = 0;
-        for (std::size_t k = 0; k < 4; ++k) {
-            float t0 = s.t0, t1 = s.t1;
+        __m128 o[3], inv[3], t0, t1;
+        Lanes(const BoxColumns& c, const Segment& s) : t0(_mm_set1_ps(s.t0)), t1(_mm_set1_ps(s.t1)) {
             for (int a = 0; a < 3; ++a) {
-                const float tn = (faces(a, s.neg[a])[j + k] - s.o[a]) * s.inv[a];
-                const float tf = (faces(a, !s.neg[a])[j + k] - s.o[a]) * s.inv[a] * 1.0000004f;
-                t0 = tn > t0 ? tn : t0;
-                t1 = tf < t1 ? tf : t1;
+                near[a] = c.faces(a, s.neg[a]), far[a] = c.faces(a, !s.neg[a]);
+                o[a] = _mm_set1_ps(s.o[a]), inv[a] = _mm_set1_ps(s.inv[a]);
             }
-            if (t0 <= t1 && t0 != kInf) mask |= 1u << k;
         }
-        return mask;
+        // Boxes j to j + 3: all ones in the lanes of the boxes met.
+        __m128 met(std::size_t j) const {
+            const __m128 widen = _mm_set1_ps(1.0000004f);
+            __m128 enter = t0, exit = t1;
+            for (int a = 0; a < 3; ++a) {
+                const __m128 tn = _mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(near[a] + j), o[a]), inv[a]);
+                const __m128 tf = _mm_mul_ps(_mm_mul_ps(_mm_sub_ps(_mm_loadu_ps(far[a] + j), o[a]), inv[a]), widen);
+                enter = _mm_max_ps(tn, enter);  // tn > enter ? tn : enter
+                exit = _mm_min_ps(tf, exit);    // tf < exit ? tf : exit
+            }
+            // box_entry returns the entry when it is <= the exit (else +inf): met when finite.
+            return _mm_and_ps(_mm_cmple_ps(enter, exit), _mm_cmplt_ps(enter, _mm_set1_ps(kInf)));
+        }
+        unsigned met_bits(std::size_t j) const { return static_cast<unsigned>(_mm_movemask_ps(met(j))); }
+#else
+        const Segment& s;
+        Lanes(const BoxColumns& c, const Segment& seg) : s(seg) {
+            for (int a = 0; a < 3; ++a) near[a] = c.faces(a, s.neg[a]), far[a] = c.faces(a, !s.neg[a]);
+        }
+        // Bit k set when box j + k is met.
+        unsigned met_bits(std::size_t j) const {
+            unsigned mask = 0;
+            for (std::size_t k = 0; k < 4; ++k) {
+                float enter = s.t0, exit = s.t1;
+                for (int a = 0; a < 3; ++a) {
+                    const float tn = (near[a][j + k] - s.o[a]) * s.inv[a];
+                    const float tf = (far[a][j + k] - s.o[a]) * s.inv[a] * 1.0000004f;
+                    enter = tn > enter ? tn : enter;
+                    exit = tf < exit ? tf : exit;
+                }
+                if (enter <= exit && enter != kInf) mask |= 1u << k;
+            }
+            return mask;
+        }
 #endif
-    }
+    };
 
     std::size_t n_ = 0, padded_ = 0;
     std::vector<float> lo_[3], hi_[3];

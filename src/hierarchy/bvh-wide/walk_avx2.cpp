@@ -12,11 +12,6 @@
 
 namespace rtcost::wide {
 
-bool cpu_has_avx2() {
-    __builtin_cpu_init();
-    return __builtin_cpu_supports("avx2");
-}
-
 #if defined(__clang__)
 #pragma clang attribute push(__attribute__((target("avx2"))), apply_to = function)
 #else
@@ -95,7 +90,6 @@ Walks walks_avx2(int width, int tri_lanes) { return avx2::make(width, tri_lanes)
 #else
 
 namespace rtcost::wide {
-bool cpu_has_avx2() { return false; }
 Walks walks_avx2(int width, int) { return walks_baseline(width); }
 }  // namespace rtcost::wide
 

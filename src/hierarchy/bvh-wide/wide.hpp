@@ -16,6 +16,7 @@
 
 #include "../common/impl.hpp"
 #include "scene/watertight.hpp"
+#include "util/cpu.hpp"
 
 namespace rtcost::wide {
 
@@ -99,8 +100,6 @@ struct Walks {
 /// packs of 4) and, on x86-64, for AVX2 (packs of `tri_lanes`, 4 or 8); `width` is 4 or 8.
 Walks walks_baseline(int width);
 Walks walks_avx2(int width, int tri_lanes);
-/// Whether this CPU (and its operating system) runs AVX2.
-bool cpu_has_avx2();
 
 class BvhWide final : public HierarchyImpl<BvhWide> {
 public:

@@ -57,6 +57,12 @@ Assign parse_assign(const Params& p) {
     return p.is("assign", "exact") ? Assign::Exact : Assign::Bounds;
 }
 
+std::vector<Box3> prim_bounds(const Scene& s) {
+    std::vector<Box3> out(s.size());
+    for (std::uint32_t id = 0; id < s.size(); ++id) out[id] = s.prim_bounds(id);
+    return out;
+}
+
 bool overlaps(const Scene& s, std::uint32_t id, const Box3& pb, const Box3& cell, Assign how) {
     if (!pb.overlaps(cell)) return false;
     if (how == Assign::Bounds) return true;

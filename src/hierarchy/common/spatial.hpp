@@ -29,6 +29,10 @@ inline const ParamSpec kMailboxParam = ParamSpec::flag("mailbox", "0", "1: each 
 
 Assign parse_assign(const Params& p);
 
+/// Every primitive's bounding box, by id (Scene::prim_bounds): what cell assignment reads for
+/// each primitive at every node or grid built.
+std::vector<Box3> prim_bounds(const Scene& s);
+
 /// True when primitive `id`, whose bounding box is `pb`, is to be referenced by `cell`.
 /// Exact tests: triangles and polygons by clipping against the cell (separating axes for
 /// triangles), spheres by the cell meeting the sphere's surface (not lying wholly inside or

@@ -7,9 +7,7 @@
 
 namespace rtcost::subdiv {
 
-Assigner::Assigner(const Scene& s, spatial::Assign how) : s_(s), how_(how), bounds_(s.size()) {
-    for (std::uint32_t i = 0; i < s.size(); ++i) bounds_[i] = s.prim_bounds(i);
-}
+Assigner::Assigner(const Scene& s, spatial::Assign how) : s_(s), how_(how), bounds_(spatial::prim_bounds(s)) {}
 
 std::vector<std::uint32_t> Assigner::all() const {
     std::vector<std::uint32_t> r;

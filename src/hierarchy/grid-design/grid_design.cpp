@@ -16,7 +16,7 @@ std::vector<Candidate> search_resolution(const Scene& s, const DesignInput& in, 
     std::map<std::array<int, 3>, double> seen;
     const Box3 box = s.bounds();
     const designing::SampleReplay replay(s, in.sample, in.costs);
-    const std::vector<Box3> bounds = all_prim_bounds(s);  // once for every candidate
+    const std::vector<Box3> bounds = spatial::prim_bounds(s);  // once for every candidate
     // The cheapest grid built so far, kept rather than built again at the end.
     std::unique_ptr<Grid> kept;
     double kept_cost = kInf;

@@ -115,14 +115,8 @@ std::array<int, 3> resolution(std::string_view spec, double density, std::size_t
     return clamp_res(v);
 }
 
-std::vector<Box3> all_prim_bounds(const Scene& s) {
-    std::vector<Box3> out(s.size());
-    for (std::uint32_t id = 0; id < s.size(); ++id) out[id] = s.prim_bounds(id);
-    return out;
-}
-
 Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox)
-    : Grid(s, res, assign, mailbox, all_prim_bounds(s)) {}
+    : Grid(s, res, assign, mailbox, spatial::prim_bounds(s)) {}
 
 Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox, std::span<const Box3> bounds)
     : HierarchyImpl(s), box_(s.bounds()), empty_(s.empty() || s.bounds().empty()), res_(res), mailbox_(mailbox) {
@@ -145,14 +139,12 @@ Grid::Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool 
         inv_cell_[a] = ext > 0 ? static_cast<float>(r) / ext : 0.0f;
     }
 
-    // Every cell each primitive's box overlaps (closed intervals), primitives in id order: from
-    // the first cell whose upper boundary reaches the box's lo to the last whose lower boundary
-    // is <= its hi.
-    // On each axis: lo, the first cell whose upper boundary is >= the box's lo (the last cell if
-    // none is), and hi, the last cell whose lower boundary is <= its hi (the first if none is),
-    // found from guess() by stepping along the planes (a cell or two at most) rather than by a
-    // binary search over them, which was most of a grid's build (a grid-design search builds a
-    // score of grids). The same cells as lower_bound and upper_bound find, NaN included.
+    // Every cell each primitive's box overlaps (closed intervals), primitives in id order. On
+    // each axis: from the first cell whose upper boundary is >= the box's lo (the last cell if
+    // none is) to the last whose lower boundary is <= its hi (the first if none is), found from
+    // guess() by stepping along the planes (a cell or two at most) rather than by a binary search
+    // over them, which was most of a grid's build (a grid-design search builds a score of grids):
+    // the cells lower_bound and upper_bound find, NaN included.
     auto each_overlap = [&](auto&& f) {
         for (std::uint32_t id = 0; id < s.size(); ++id) {
             const Box3& pb = bounds[id];

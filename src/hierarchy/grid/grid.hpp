@@ -38,13 +38,10 @@ inline constexpr double kFlat = 1e-6;
 /// naming `res` for a bad spec.
 std::array<int, 3> resolution(std::string_view spec, double density, std::size_t n, const Box3& box);
 
-/// Every primitive's bounds, by id (Scene::prim_bounds).
-std::vector<Box3> all_prim_bounds(const Scene& s);
-
 class Grid final : public HierarchyImpl<Grid> {
 public:
     Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox);
-    /// The same grid from the primitives' bounds, `bounds[id] = s.prim_bounds(id)`, computed
+    /// The same grid from the primitives' bounds (spatial::prim_bounds), computed
     /// once for the several grids of a search.
     Grid(const Scene& s, std::array<int, 3> res, spatial::Assign assign, bool mailbox, std::span<const Box3> bounds);
 
