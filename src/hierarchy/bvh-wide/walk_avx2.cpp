@@ -32,6 +32,7 @@ struct P4 {
     static P4 mul(P4 a, P4 b) { return {_mm_mul_ps(a.v, b.v)}; }
     static P4 add(P4 a, P4 b) { return {_mm_add_ps(a.v, b.v)}; }
     static P4 div(P4 a, P4 b) { return {_mm_div_ps(a.v, b.v)}; }
+    static P4 abs(P4 a) { return {_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)}; }
     static __m128 lt(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_LT_OQ); }
     static __m128 gt(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_GT_OQ); }
     static __m128 eq(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_EQ_OQ); }
@@ -53,6 +54,7 @@ struct P8 {
     static P8 mul(P8 a, P8 b) { return {_mm256_mul_ps(a.v, b.v)}; }
     static P8 add(P8 a, P8 b) { return {_mm256_add_ps(a.v, b.v)}; }
     static P8 div(P8 a, P8 b) { return {_mm256_div_ps(a.v, b.v)}; }
+    static P8 abs(P8 a) { return {_mm256_andnot_ps(_mm256_set1_ps(-0.0f), a.v)}; }
     static __m256 lt(P8 a, P8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_LT_OQ); }
     static __m256 gt(P8 a, P8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_GT_OQ); }
     static __m256 eq(P8 a, P8 b) { return _mm256_cmp_ps(a.v, b.v, _CMP_EQ_OQ); }

@@ -1,6 +1,7 @@
 // bvh-wide traversals for the baseline instruction set: SSE2 on x86-64 (four lanes in one
 // register, eight in two), plain per-lane loops elsewhere.
 #include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "wide.hpp"
@@ -22,6 +23,7 @@ struct P4 {
     static P4 mul(P4 a, P4 b) { return {_mm_mul_ps(a.v, b.v)}; }
     static P4 add(P4 a, P4 b) { return {_mm_add_ps(a.v, b.v)}; }
     static P4 div(P4 a, P4 b) { return {_mm_div_ps(a.v, b.v)}; }
+    static P4 abs(P4 a) { return {_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)}; }  // the sign bit cleared
     static __m128 lt(P4 a, P4 b) { return _mm_cmplt_ps(a.v, b.v); }
     static __m128 gt(P4 a, P4 b) { return _mm_cmpgt_ps(a.v, b.v); }
     static __m128 eq(P4 a, P4 b) { return _mm_cmpeq_ps(a.v, b.v); }
@@ -43,6 +45,7 @@ struct P4 {
     static P4 mul(P4 a, P4 b) { return {{a.v[0] * b.v[0], a.v[1] * b.v[1], a.v[2] * b.v[2], a.v[3] * b.v[3]}}; }
     static P4 add(P4 a, P4 b) { return {{a.v[0] + b.v[0], a.v[1] + b.v[1], a.v[2] + b.v[2], a.v[3] + b.v[3]}}; }
     static P4 div(P4 a, P4 b) { return {{a.v[0] / b.v[0], a.v[1] / b.v[1], a.v[2] / b.v[2], a.v[3] / b.v[3]}}; }
+    static P4 abs(P4 a) { return {{std::fabs(a.v[0]), std::fabs(a.v[1]), std::fabs(a.v[2]), std::fabs(a.v[3])}}; }
     template <class F>
     static unsigned mask(P4 a, P4 b, F f) {
         unsigned m = 0;
