@@ -11,6 +11,7 @@
 
 #include "../common/impl.hpp"
 #include "../common/leaf_prims.hpp"
+#include "pair_entry.hpp"
 
 namespace rtcost::bvh {
 
@@ -124,6 +125,7 @@ private:
         int sp = 0;
         const Node* nodes = d_.nodes.data();
         const RayInv ri(ray);
+        const PairRay pair_ray(ri);
         // Three divisions a ray pays only where it reaches a leaf with triangles to test (not in a
         // scene of spheres, nor on the shadow rays of a mesh that reach no leaf).
         RayShear shear;
@@ -155,17 +157,17 @@ private:
                     // visited next without a trip through the stack.
                     counting.box();
                     counting.box();
-                    const float ta = box_entry(nodes[n.index].box, ri, ray.tmin, limit);
-                    const float tb = box_entry(nodes[n.index + 1].box, ri, ray.tmin, limit);
+                    // What either child's visit reads, fetched while their boxes are tested.
+                    prefetch(nodes[n.index]);
+                    prefetch(nodes[n.index + 1]);
+                    float ta, tb;
+                    pair_entry(nodes[n.index].box, nodes[n.index + 1].box, pair_ray, ray.tmin, limit, ta, tb);
                     Entry a{n.index, ta, e.depth + 1}, b{n.index + 1, tb, e.depth + 1};
                     if constexpr (kOrdered) {
                         if (second_first<Q>(nodes[a.node].leaf, nodes[b.node].leaf, ta, tb)) std::swap(a, b);
                     }
                     if (a.t != kInf) {
-                        if (b.t != kInf) {
-                            stack[sp++] = b;
-                            prefetch(nodes[b.node]);
-                        }
+                        if (b.t != kInf) stack[sp++] = b;
                         e = a;
                         continue;
                     }
