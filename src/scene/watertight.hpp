@@ -6,6 +6,7 @@
 // bit for bit (the library is built with -ffp-contract=off, so no fused multiply-add either).
 
 #include <cmath>
+#include <cstring>
 #include <utility>
 
 #include "rtcost/primitive.hpp"
@@ -34,15 +35,29 @@ struct RayShear {
 bool watertight_finish_in_double(double u, double v, double w, float az, float bz, float cz, const Ray& ray,
                                  float& t);
 
+/// Component `k` of `v` minus that of `o`, the components read from memory by index.
+[[gnu::always_inline]] inline float axis_minus(const Vec3& v, const Vec3& o, int k) {
+    float a, b;
+    std::memcpy(&a, reinterpret_cast<const char*>(&v) + sizeof(float) * k, sizeof a);
+    std::memcpy(&b, reinterpret_cast<const char*>(&o) + sizeof(float) * k, sizeof b);
+    return a - b;
+}
+
 /// Watertight test of `tri` against `ray`, whose shear is `s` (= RayShear(ray.d)).
 [[gnu::always_inline]] inline bool intersect(const Triangle& tri, const Ray& ray, const RayShear& s, float& t) {
-    const Vec3 a = tri.v0 - ray.o, b = tri.v1 - ray.o, c = tri.v2 - ray.o;
-    const float ax = a[s.kx] - s.sx * a[s.kz], ay = a[s.ky] - s.sy * a[s.kz];
-    const float bx = b[s.kx] - s.sx * b[s.kz], by = b[s.ky] - s.sy * b[s.kz];
-    const float cx = c[s.kx] - s.sx * c[s.kz], cy = c[s.ky] - s.sy * c[s.kz];
+    // Components by index read from memory (Vec3::operator[] selects among x, y, z by compares):
+    // vertex minus origin on the permuted axes, the same subtractions as (tri.v0 - ray.o)[k].
+    const struct {
+        float x, y, z;
+    } a{axis_minus(tri.v0, ray.o, s.kx), axis_minus(tri.v0, ray.o, s.ky), axis_minus(tri.v0, ray.o, s.kz)},
+        b{axis_minus(tri.v1, ray.o, s.kx), axis_minus(tri.v1, ray.o, s.ky), axis_minus(tri.v1, ray.o, s.kz)},
+        c{axis_minus(tri.v2, ray.o, s.kx), axis_minus(tri.v2, ray.o, s.ky), axis_minus(tri.v2, ray.o, s.kz)};
+    const float ax = a.x - s.sx * a.z, ay = a.y - s.sy * a.z;
+    const float bx = b.x - s.sx * b.z, by = b.y - s.sy * b.z;
+    const float cx = c.x - s.sx * c.z, cy = c.y - s.sy * c.z;
     const float u1 = cx * by, u2 = cy * bx, v1 = ax * cy, v2 = ay * cx, w1 = bx * ay, w2 = by * ax;
     const float u = u1 - u2, v = v1 - v2, w = w1 - w2;
-    const float az = s.sz * a[s.kz], bz = s.sz * b[s.kz], cz = s.sz * c[s.kz];
+    const float az = s.sz * a.z, bz = s.sz * b.z, cz = s.sz * c.z;
     // Each edge value is a difference of two rounded products: its sign is certain only when it
     // exceeds their rounding (2^-24 of each); a long thin triangle's edge values cancel far
     // below that and would report hits beside the triangle.
