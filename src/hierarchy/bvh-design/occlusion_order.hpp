@@ -69,6 +69,7 @@ private:
     bool occlusion(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {
         const Node* nodes = nodes_.data();
         const RayInv ri(ray);
+        const PairRay pair_ray(ri);
         // The direction's signs in one register, for decoding the nodes' orders.
         const std::uint32_t neg_bits = static_cast<std::uint32_t>(ri.neg[0] | ri.neg[1] << 1 | ri.neg[2] << 2);
         counting.box();
@@ -99,8 +100,8 @@ private:
                     // the order is decoded, so that neither test waits for it.
                     counting.box();
                     counting.box();
-                    const float ta = box_entry(nodes[n.index].box, ri, ray.tmin, ray.tmax);
-                    const float tb = box_entry(nodes[n.index + 1].box, ri, ray.tmin, ray.tmax);
+                    float ta, tb;
+                    pair_entry(nodes[n.index].box, nodes[n.index + 1].box, pair_ray, ray.tmin, ray.tmax, ta, tb);
                     // The byte decoded as any_order_first_child_first does (model_tree.hpp),
                     // from the packed count and the signs held in neg_bits (the walk timed in
                     // docs/design.md on 2026-12-06).

@@ -49,6 +49,7 @@ void price_occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sam
     };
     const Ray* ray = nullptr;
     RayInv ri(Ray{});
+    PairRay pair_ray(ri);
     model::KnownCrossings known;
     // The subtree of `node` walked by the ray (every child it meets, the orders as they are).
     auto walk = [&](auto&& self, std::uint32_t node) -> Walked {
@@ -63,8 +64,14 @@ void price_occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sam
             }
             return {c, false};
         }
-        const bool ma = box_entry(d.nodes[n.index].box, ri, ray->tmin, ray->tmax) != kInf;
-        const bool mb = n.count == 2 && box_entry(d.nodes[n.index + 1].box, ri, ray->tmin, ray->tmax) != kInf;
+        bool ma, mb = false;
+        if (n.count == 2) {
+            float ta, tb;
+            pair_entry(d.nodes[n.index].box, d.nodes[n.index + 1].box, pair_ray, ray->tmin, ray->tmax, ta, tb);
+            ma = ta != kInf, mb = tb != kInf;
+        } else {
+            ma = box_entry(d.nodes[n.index].box, ri, ray->tmin, ray->tmax) != kInf;
+        }
         if (!ma && !mb) return {interior_cost, false};
         if (ma != mb) {
             const Walked w = self(self, n.index + (ma ? 0 : 1));
@@ -87,6 +94,7 @@ void price_occlusion_bits(const BvhData& d, const Scene& s, const RaySample& sam
         for (std::uint32_t r : rays) {
             ray = &sample.rays.rays[r];
             ri = RayInv(*ray);
+            pair_ray = PairRay(ri);
             known = model::KnownCrossings(sample.crossings_of(r));
             if (box_entry(d.nodes[0].box, ri, ray->tmin, ray->tmax) != kInf) walk(walk, 0);
         }
