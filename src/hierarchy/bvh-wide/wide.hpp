@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "../common/impl.hpp"
+#include "../common/tri_pack.hpp"
 #include "scene/watertight.hpp"
 #include "util/cpu.hpp"
 
@@ -42,15 +43,6 @@ inline constexpr int kMaxDepth = 100;
 struct Other {
     std::uint32_t id = 0;
     PrimKind kind = PrimKind::Sphere;
-};
-
-/// `K` triangles of a leaf (triangles and three-vertex polygons) side by side, one lane each:
-/// `v[3 i + a]` is vertex i's coordinate on axis a. Lanes past the leaf's count are unused.
-template <int K>
-struct alignas(32) TriPack {
-    float v[9][K];
-    std::uint32_t id[K];
-    PrimKind kind[K];
 };
 
 /// The pack width of a leaf of `ntri` triangles in a tree of `tri_lanes`-lane packs: a leaf of

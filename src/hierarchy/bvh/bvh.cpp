@@ -14,12 +14,16 @@ PrimInfo::PrimInfo(const Scene& s) : bounds(s.size()), centroids(s.size()) {
 
 Bvh::Bvh(const Scene& s, std::string name, BvhData data, bool ordered)
     : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered), prims_(leaf_prims(s, d_.refs)),
-      has_triangles_(std::any_of(prims_.begin(), prims_.end(), [](const LeafPrim& p) { return p.as_triangle; })) {}
+      packs_(prims_),
+      has_triangles_(std::any_of(prims_.begin(), prims_.end(), [](const LeafPrim& p) { return p.as_triangle; })) {
+    if (packs_.active()) prims_ = {};  // the packs hold every reference
+}
 
 StructureStats Bvh::compute_structure() const {
     StructureStats s = tree_structure(
         d_.nodes, [](const Node& n) { return n.leaf != 0; }, [](const Node& n) { return std::uint32_t(n.count); });
-    s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + prims_.size() * sizeof(LeafPrim);
+    s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + prims_.size() * sizeof(LeafPrim) +
+              packs_.bytes();
     s.limits = d_.limits;
     return s;
 }

@@ -11,6 +11,7 @@
 
 #include "../common/impl.hpp"
 #include "../common/leaf_prims.hpp"
+#include "leaf_packs.hpp"
 #include "pair_entry.hpp"
 
 namespace rtcost::bvh {
@@ -93,7 +94,9 @@ public:
     /// Fetches what a visit of node `i` reads first (a walk about to wait on memory).
     void prefetch_node(std::uint32_t i) const { prefetch(d_.nodes[i]); }
     /// Fetches the leaf primitives from leaf order position `first` (a leaf's Node::index).
-    void prefetch_prims(std::uint32_t first) const { __builtin_prefetch(prims_.data() + first); }
+    void prefetch_prims(std::uint32_t first) const {
+        __builtin_prefetch(packs_.active() ? packs_.at(first) : static_cast<const void*>(prims_.data() + first));
+    }
 
     template <class C, Query Q>
     bool trace(const Ray& ray, Hit& hit, C& counting) const {
@@ -213,28 +216,49 @@ private:
         return found;
     }
 
-    /// Tests the leaf's `count` primitives from prims_[first]; true when an any-hit query ends.
+    /// Tests the leaf's `count` primitives from reference `first` (of packs_ where it has them,
+    /// else prims_); true when an any-hit query ends.
     template <class C, Query Q, class PrimTest>
     bool test_leaf(std::uint32_t first, std::uint32_t count, const Ray& ray, const RayShear& shear, Hit& hit, C& counting,
                    bool& found, PrimTest& test) const {
-        for (const LeafPrim* p = prims_.data() + first; p != prims_.data() + first + count; ++p) {
-            bool met;
+        if (packs_.active()) {
+            // A mesh: its triangles four at a time, the same tests, counts and order.
             if constexpr (std::is_same_v<PrimTest, RealPrimTest>) {
-                met = test_prim(*scene_, *p, ray, shear, hit, counting);
-            } else if constexpr (requires { test.keep(p->id, 0.0f, hit); }) {
-                // A test that only sorts real hits (CrossingCollector) is given the leaves' own
-                // exact test first, as a real trace is.
-                Hit h = hit;
-                met = test_prim(*scene_, *p, ray, shear, h, counting) && test.keep(p->id, h.t, hit);
+                return packs::test_range<C, Q>(packs_.packs.data(), first, count, packs::Shear<packs::F4>(shear, ray), ray,
+                                               hit, counting, found);
             } else {
-                met = test(p->id, ray, hit, counting);
-            }
-            if (met) {
-                found = true;
-                if constexpr (Q == Query::Any) return true;
+                for (std::uint32_t k = first; k < first + count; ++k) {
+                    LeafPrim p;
+                    if constexpr (requires { test.keep(0u, 0.0f, hit); }) p = packs_.prim(k);
+                    else p.id = packs_.id(k);  // all such a test reads
+                    if (test_one<C, Q>(p, ray, shear, hit, counting, found, test)) return true;
+                }
+                return false;
             }
         }
+        for (const LeafPrim* p = prims_.data() + first; p != prims_.data() + first + count; ++p)
+            if (test_one<C, Q>(*p, ray, shear, hit, counting, found, test)) return true;
         return false;
+    }
+
+    /// One reference of a leaf, as test_leaf tests it; true when an any-hit query ends.
+    template <class C, Query Q, class PrimTest>
+    bool test_one(const LeafPrim& p, const Ray& ray, const RayShear& shear, Hit& hit, C& counting, bool& found,
+                  PrimTest& test) const {
+        bool met;
+        if constexpr (std::is_same_v<PrimTest, RealPrimTest>) {
+            met = test_prim(*scene_, p, ray, shear, hit, counting);
+        } else if constexpr (requires { test.keep(p.id, 0.0f, hit); }) {
+            // A test that only sorts real hits (CrossingCollector) is given the leaves' own
+            // exact test first, as a real trace is.
+            Hit h = hit;
+            met = test_prim(*scene_, p, ray, shear, h, counting) && test.keep(p.id, h.t, hit);
+        } else {
+            met = test(p.id, ray, hit, counting);
+        }
+        if (!met) return false;
+        found = true;
+        return Q == Query::Any;
     }
 
     /// An ordered visit of a binary node: whether the second child (a leaf if `lb`, entered at
@@ -248,7 +272,7 @@ private:
 
     /// Incoherent rays wait on memory: what a visit of `n` reads first, fetched ahead.
     void prefetch(const Node& n) const {
-        if (n.leaf) __builtin_prefetch(prims_.data() + n.index);
+        if (n.leaf) prefetch_prims(n.index);
         else __builtin_prefetch(d_.nodes.data() + n.index);
     }
 
@@ -256,7 +280,8 @@ private:
     BvhData d_;
     bool ordered_;
     bool any_leaves_first_ = false;
-    std::vector<LeafPrim> prims_;  ///< BvhData::refs as their tests need them, in leaf order
+    std::vector<LeafPrim> prims_;  ///< BvhData::refs as their tests need them, in leaf order (none with packs_)
+    LeafPacks packs_;              ///< the same in packs of four, for a mesh (every reference a triangle)
     bool has_triangles_ = false;    ///< some LeafPrim is tested as a triangle (RayShear needed)
 };
 
