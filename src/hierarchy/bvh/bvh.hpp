@@ -272,8 +272,14 @@ private:
 
     /// Incoherent rays wait on memory: what a visit of `n` reads first, fetched ahead.
     void prefetch(const Node& n) const {
-        if (n.leaf) prefetch_prims(n.index);
-        else __builtin_prefetch(d_.nodes.data() + n.index);
+        if (!n.leaf) __builtin_prefetch(d_.nodes.data() + n.index);
+        else if (!packs_.active()) __builtin_prefetch(prims_.data() + n.index);
+        else if (n.count > 0) {
+            // Every line of the packs the leaf's lanes lie in (a leaf of two can span two packs).
+            const char* a = static_cast<const char*>(packs_.at(n.index));
+            const char* b = static_cast<const char*>(packs_.at(n.index + n.count - 1)) + sizeof(TriPack<4>);
+            for (; a < b; a += 64) __builtin_prefetch(a);
+        }
     }
 
     std::string name_;
