@@ -121,6 +121,9 @@ struct ModelFlags {
     /// it), nearest entry first within leaves and within interior nodes, a tie to the later
     /// child (bvh-wide's `any_order=leaves`); false: as a closest-hit query orders them.
     bool any_leaves_first = false;
+    /// An any-hit query visits the children it meets in stored order, first child first, whatever
+    /// their entries (bvh-wide's `any_order=stored`); overrides any_leaves_first.
+    bool any_stored = false;
     /// A child whose region a stretch of the ray (not a single point) only touches -- the ray
     /// passing exactly through an edge or corner of its cell -- is entered: a grid's 3DDDA passes
     /// a corner one axis at a time. False: the traversal crosses an edge or corner in one step and

@@ -265,6 +265,7 @@ bool BvhWide::emit_model(ModelSink& sink) const {
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     f.cull_widened = true;
     f.any_leaves_first = d_->any_order == kAnyLeaves;
+    f.any_stored = d_->any_order == kAnyStored;
     if (!sink.begin(f) || d_->root_count == 0) return true;
     ModelNode root;
     root.region = root.bv = d_->root_box;
@@ -326,7 +327,7 @@ std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p) {
     }
     d->tri_lanes = use_avx2 && !p.is("tri_lanes", "4") ? 8 : 4;
     const std::string& ao = p.str("any_order");
-    d->any_order = ao == "nearest" ? kAnyNearest : kAnyLeaves;
+    d->any_order = ao == "nearest" ? kAnyNearest : ao == "leaves" ? kAnyLeaves : kAnyStored;
     if (d->width == 8) {
         if (d->tri_lanes == 8) pack_leaves<8, 8>(*d, d->n8, bd, s);
         else pack_leaves<8, 4>(*d, d->n8, bd, s);
@@ -345,9 +346,9 @@ const Registration reg{
                         "children per node: 4, 8, or auto (8 where the CPU runs AVX2, else 4)"),
       ParamSpec::choice("simd", "auto", {"auto", "baseline", "avx2"},
                         "instruction set of the traversal: auto, baseline (SSE2) or avx2"),
-      ParamSpec::choice("any_order", "leaves", {"leaves", "nearest"},
-                        "order of the children met in any-hit (occlusion) queries: leaf children first, then "
-                        "nearest first; or nearest first, as closest-hit queries"),
+      ParamSpec::choice("any_order", "stored", {"stored", "leaves", "nearest"},
+                        "order of the children met in any-hit (occlusion) queries: as stored, unsorted; leaf "
+                        "children first, then nearest first; or nearest first, as closest-hit queries"),
       ParamSpec::choice("tri_lanes", "auto", {"auto", "4", "8"},
                         "triangles tested at once: 4, 8 (AVX2 only), or auto (8 where the CPU runs AVX2, else 4)"),
       ParamSpec::integer("max_prims", "16", 1, 64, "largest leaf of the SAH tree collapsed (bigger nodes are always split)"),
@@ -359,6 +360,7 @@ const Registration reg{
     {{{}, kTestHits | kTestSampled},
      {{"width=4"}, kTestHits | kTestSampled},
      {{"any_order=nearest"}, kTestHits | kTestSampled},
+     {{"any_order=leaves"}, kTestHits | kTestSampled},
      {{"width=8", "simd=baseline", "max_prims=1"}, kTestHits},
      {{"width=4", "simd=baseline", "max_prims=8"}, kTestHits},
      {{"tri_lanes=4"}, kTestHits}}};

@@ -22,31 +22,14 @@ namespace packs {
 using F4 = lanes::F4;
 #include "../common/tri_pack_test.inc"
 
-/// References [first, first + count) of `packs`: tested a pack at a time, counted as the
-/// scalar leaf loop counts (an any-hit query stops at its first hit), a later lane taken only
-/// when strictly nearer. True when an any-hit query ends.
+/// References [first, first + count) of `packs`: tested a pack at a time by test_lanes (a
+/// leaf's references may start and end anywhere in a pack). True when an any-hit query ends.
 template <class C, Query Q>
 bool test_range(const TriPack<4>* packs, std::uint32_t first, std::uint32_t count, const Shear<F4>& shear,
                 const Ray& ray, Hit& hit, C& counting, bool& found) {
     for (std::uint32_t k = first, end = first + count; k < end;) {
-        const TriPack<4>& pk = packs[k / 4];
         const std::uint32_t lo = k % 4, hi = std::min<std::uint32_t>(4, lo + (end - k));
-        alignas(16) float ts[4];
-        unsigned met = test_pack<F4, 4>(pk, shear, ray, hit.t < ray.tmax ? hit.t : ray.tmax,
-                                        ((1u << hi) - 1) & ~((1u << lo) - 1), ts);
-        if constexpr (C::enabled) {
-            const std::uint32_t tested = Q == Query::Any && met ? static_cast<std::uint32_t>(__builtin_ctz(met)) + 1 : hi;
-            for (std::uint32_t l = lo; l < tested; ++l) counting.prim(pk.kind[l]);
-        }
-        for (; met; met &= met - 1) {
-            const int l = __builtin_ctz(met);
-            if (ts[l] < hit.t) {
-                hit.t = ts[l];
-                hit.prim = static_cast<std::int32_t>(pk.id[l]);
-                found = true;
-                if constexpr (Q == Query::Any) return true;
-            }
-        }
+        if (test_lanes<F4, 4, C, Q>(packs[k / 4], lo, hi, shear, ray, hit, counting, found)) return true;
         k += hi - lo;
     }
     return false;
