@@ -4,9 +4,9 @@
 // the node, among the surface area's cheapest splits (8, 16 or 32 of them: the count that designs
 // the cheapest tree on half the sample when designed on the other half); a node stays a leaf
 // where no split pays; and the order in which occlusion rays enter
-// a node's children: front to back or leaf children first, whichever the model predicts cheaper
-// on the sample (or, with occlusion=sample, an order per node and direction priced on the sample,
-// on the designed tree or on bvh-sah's, whichever its own walk prices cheaper on the sample:
+// a node's children: front to back, leaf children first or as stored, whichever the model predicts
+// cheapest on the sample (or, with occlusion=sample, an order per node and direction priced on the
+// sample, on the designed tree or on bvh-sah's, whichever its own walk prices cheaper on the sample:
 // occlusion_order.hpp).
 // Otherwise traversed as every BVH (../bvh/bvh.hpp).
 #include <algorithm>
@@ -250,12 +250,13 @@ const Registration reg{
                                         "designed on the other half",
                                         {"auto"}));
          p.push_back(ParamSpec::choice(
-             "occlusion", "auto", {"auto", "near", "leaves", "sample"},
-             "order in which occlusion rays enter a node's children: near (front to back, as every BVH), leaves "
-             "(leaf children first, then front to back), auto (of near and leaves, the one the model predicts "
-             "cheaper on the sample), or sample (by node and by the way the ray crosses it, the child whose order "
-             "makes the subtree cheapest for the sample first, on the designed tree or bvh-sah's, or bvh-sah front "
-             "to back, whichever its walk prices cheapest on the sample)"));
+             "occlusion", "auto", {"auto", "near", "leaves", "stored", "sample"},
+             "order in which occlusion rays enter a node's children: near (front to back), leaves (leaf children "
+             "first, then front to back), stored (first child first, unsorted: bvh-sah's default), auto (of near, "
+             "leaves and stored, the one the model predicts cheapest on the sample), or sample (by node and by the "
+             "way the ray crosses it, the child whose order makes the subtree cheapest for the sample first, on the "
+             "designed tree or bvh-sah's, or bvh-sah front to back, whichever its walk prices cheapest on the "
+             "sample)"));
          p.push_back(ParamSpec::real("trust", "32", 0, 1e30,
                                      "sample segments at a node at which sample and surface area weigh alike "
                                      "(large: the surface area heuristic)"));
@@ -292,37 +293,48 @@ const Registration reg{
          // land in memory, docs/design.md.)
          if (!p.is("occlusion", "sample") || !any_query) {
              auto designed = std::make_unique<Bvh>(s, "bvh-design", std::move(designed_tree), true);
-             // Each tree in the order asked for, or in the order the model predicts cheaper on
-             // the sample (only its occlusion rays can tell the two apart).
-             const bool try_near = !p.is("occlusion", "leaves");
-             const bool try_leaves = p.is("occlusion", "leaves") || (p.is("occlusion", "auto") && any_query);
+             // Each tree in the order asked for, or in the order the model predicts cheapest on
+             // the sample (only its occlusion rays can tell them apart).
+             enum class Order { Near, Leaves, Stored };
+             auto tried = [&](Order o) {
+                 if (p.is("occlusion", "leaves")) return o == Order::Leaves;
+                 if (p.is("occlusion", "stored")) return o == Order::Stored;
+                 // near, and sample without occlusion rays: front to back alone.
+                 return o == Order::Near || (p.is("occlusion", "auto") && any_query);
+             };
+             auto set_order = [](Bvh& h, Order o) {
+                 h.set_any_leaves_first(o == Order::Leaves);
+                 h.set_any_stored(o == Order::Stored);
+             };
              struct Choice {
                  Bvh* h;
-                 bool leaves;
+                 Order order;
                  double cost;
-             } best{nullptr, false, 0};
+             } best{nullptr, Order::Near, 0};
              // Each priced by its own traversal of the sample (design/replay.hpp): the model's
              // prediction without materialising the trees' model trees.
              const designing::SampleReplay replay(s, in.sample, in.costs);
              using Rays = designing::SampleReplay::Rays;
              for (Bvh* h : {designed.get(), by_sah.get()}) {  // a tie keeps the designed splits
-                 // The other rays go the same way in either order: replayed once.
+                 // The other rays go the same way in any order: replayed once.
                  const RayCounters others = replay.counters(*h, Rays::Others);
-                 for (bool leaves : {false, true}) {
-                     if (!(leaves ? try_leaves : try_near)) continue;
-                     h->set_any_leaves_first(leaves);
+                 for (Order o : {Order::Near, Order::Leaves, Order::Stored}) {
+                     if (!tried(o)) continue;
+                     set_order(*h, o);
                      RayCounters whole = others;
                      whole += replay.counters(*h, Rays::Occlusion);
                      const double c = replay.time(*h, whole);
-                     if (!best.h || c < best.cost) best = {h, leaves, c};
+                     if (!best.h || c < best.cost) best = {h, o, c};
                  }
              }
-             best.h->set_any_leaves_first(best.leaves);
+             set_order(*best.h, best.order);
              if (best.h == designed.get()) return designed;
              return by_sah;
          }
-         // Of bvh-sah's tree walked front to back and each tree with its order bits, the cheapest
-         // by its own traversal of the sample; a tie keeps the designed splits.
+         // Of bvh-sah's tree walked as bvh-sah walks it (occlusion rays in stored order) and each
+         // tree with its order bits, the cheapest by its own traversal of the sample; a tie keeps
+         // the designed splits.
+         by_sah->set_any_stored(true);
          const designing::SampleReplay replay(s, in.sample, in.costs);
          std::vector<std::uint8_t> sah_order = occlusion_bits(by_sah->data(), s, in.sample);
          price_occlusion_bits(by_sah->data(), s, in.sample, in.costs, sah_order);

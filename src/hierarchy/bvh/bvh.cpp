@@ -32,7 +32,8 @@ bool Bvh::emit_model_ordered(ModelSink& sink, std::span<const std::uint8_t> any_
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     f.cull = ordered_;
     f.cull_widened = ordered_;
-    f.any_leaves_first = ordered_ && any_leaves_first_;
+    f.any_leaves_first = ordered_ && any_leaves_first_ && !any_stored_;
+    f.any_stored = ordered_ && any_stored_;
     if (!sink.begin(f) || d_.nodes.empty()) return true;
     // Every builder lays leaves' references out depth first: a subtree's run of refs starts at
     // its leftmost leaf and ends with its rightmost.
@@ -70,21 +71,28 @@ namespace {
 // The traversal order the `order` parameter asks for, set on the built hierarchy.
 std::unique_ptr<Bvh> ordered(const Scene& s, const char* name, BvhData data, const Params& p) {
     auto h = std::make_unique<Bvh>(s, name, std::move(data), !p.is("order", "none"));
-    h->set_any_leaves_first(p.is("order", "leaves"));
+    const bool leaves = p.is("order", "leaves") || p.is("any_order", "leaves");
+    h->set_any_leaves_first(leaves);
+    h->set_any_stored(!leaves && p.is("any_order", "stored"));
     return h;
 }
 
 const ParamSpec kOrder = ParamSpec::choice("order", "near", {"near", "leaves", "none"},
                                            "near: near child first, far child skipped beyond the current hit; "
-                                           "leaves: as near, but occlusion queries enter leaf children first; "
-                                           "none: every child met is visited (the paper's BVH case)");
+                                           "leaves: as near, but occlusion queries enter leaf children first "
+                                           "(any_order=leaves); none: every child met is visited, in stored order "
+                                           "(the paper's BVH case)");
+const ParamSpec kAnyOrder = ParamSpec::choice("any_order", "stored", {"stored", "nearest", "leaves"},
+                                              "order of the children met in occlusion (any-hit) queries: stored "
+                                              "(first child first, unsorted), nearest (as closest-hit queries), or "
+                                              "leaves (leaf children first, then nearest)");
 constexpr long long kMaxLeaf = 1 << 20;
 
 const Registration median_reg{
     {"bvh-median",
      "Kay and Kajiya's BVH: object median cut on the longest axis",
      {ParamSpec::integer("max_prims", "1", 1, kMaxLeaf, "largest leaf"),
-      ParamSpec::integer("max_depth", "64", 0, kMaxDepth, "deepest leaf (root at 0)"), kOrder},
+      ParamSpec::integer("max_depth", "64", 0, kMaxDepth, "deepest leaf (root at 0)"), kOrder, kAnyOrder},
      [](const Scene& s, const Params& p) {
          MedianOptions o;
          o.max_prims = static_cast<int>(p.integer("max_prims"));
@@ -103,7 +111,7 @@ const Registration gs_reg{
       ParamSpec::integer("seed", "1", 0, 1LL << 62,
                          "insertion order: shuffled with this seed; 0 = file order (which degenerates on "
                          "meshes stored row by row)"),
-      kOrder},
+      kOrder, kAnyOrder},
      [](const Scene& s, const Params& p) {
          GsOptions o;
          o.max_prims = static_cast<int>(p.integer("max_prims"));
@@ -127,7 +135,7 @@ const Registration sah_reg{
       ParamSpec::flag("sweep", "0", "1: evaluate every split of the sorted centroids (full sweep SAH)"),
       ParamSpec::real("c_trav", "1", 0, 1e6, "SAH cost of a traversal step"),
       ParamSpec::real("c_isect", "1", 1e-6, 1e6, "SAH cost of a primitive test"),
-      kOrder},
+      kOrder, kAnyOrder},
      [](const Scene& s, const Params& p) {
          SahOptions o;
          o.max_prims = static_cast<int>(p.integer("max_prims"));
@@ -141,6 +149,7 @@ const Registration sah_reg{
     {{{}, kTestHits | kTestSampled | kTestSpdModel},
      {{"sweep=1", "order=none"}, kTestHits},
      {{"order=leaves"}, kTestHits | kTestSampled},
+     {{"any_order=nearest"}, kTestHits | kTestSampled},
      {{"order=none"}, kTestSampled}}};
 
 }  // namespace

@@ -79,6 +79,13 @@ public:
     /// large occluder held high in the tree (a floor, a wall) is tested before everything nearer.
     void set_any_leaves_first(bool on) { any_leaves_first_ = on; }
     bool any_leaves_first() const { return any_leaves_first_; }
+    /// Ordered any-hit (occlusion) queries take the children they meet in stored order, first
+    /// child first, with no comparison of their entries (as Embree's occlusion traversal): which
+    /// child holds an occluder is not told by which is nearer, and the comparison's branch is
+    /// mispredicted half the time (bvh-sah on balls-mesh's shadow rays: 10% faster for 3% more
+    /// steps; on rings-mesh's, 14% fewer steps). Overrides any_leaves_first.
+    void set_any_stored(bool on) { any_stored_ = on; }
+    bool any_stored() const { return any_stored_; }
 
     /// For another walk of the same nodes (bvh-design's occlusion order): leaf `n`'s primitive
     /// tests as this BVH's own walk makes them (with RealPrimTest, on its triangle copies in leaf
@@ -109,7 +116,9 @@ public:
     bool trace_with(const Ray& ray, Hit& hit, C& counting, PrimTest test) const {
         // Query::All never cuts by a hit found, which is the unordered walk.
         if constexpr (Q == Query::All) return walk<C, Q, false>(ray, hit, counting, test);
-        else return ordered_ ? walk<C, Q, true>(ray, hit, counting, test) : walk<C, Q, false>(ray, hit, counting, test);
+        // (An any-hit query ends at its first hit: the unordered walk is the ordered one in stored order.)
+        else if (ordered_ && !(Q == Query::Any && any_stored_)) return walk<C, Q, true>(ray, hit, counting, test);
+        else return walk<C, Q, false>(ray, hit, counting, test);
     }
 
 protected:
@@ -286,6 +295,7 @@ private:
     BvhData d_;
     bool ordered_;
     bool any_leaves_first_ = false;
+    bool any_stored_ = false;
     std::vector<LeafPrim> prims_;  ///< BvhData::refs as their tests need them, in leaf order (none with packs_)
     LeafPacks packs_;              ///< the same in packs of four, for a mesh (every reference a triangle)
     bool has_triangles_ = false;    ///< some LeafPrim is tested as a triangle (RayShear needed)
