@@ -331,9 +331,9 @@ const Registration reg{
              if (best.h == designed.get()) return designed;
              return by_sah;
          }
-         // Of bvh-sah's tree walked as bvh-sah walks it (occlusion rays in stored order) and each
-         // tree with its order bits, the cheapest by its own traversal of the sample; a tie keeps
-         // the designed splits.
+         // Each tree walked as bvh-sah walks it (occlusion rays in stored order) or with its order
+         // bytes, the cheapest by its own traversal of the sample; a tie keeps the designed splits,
+         // then the stored walk.
          by_sah->set_any_stored(true);
          const designing::SampleReplay replay(s, in.sample, in.costs);
          std::vector<std::uint8_t> sah_order = occlusion_bits(by_sah->data(), s, in.sample);
@@ -341,19 +341,38 @@ const Registration reg{
          auto sah_ordered = std::make_unique<DesignedBvh>(s, by_sah->data(), std::move(sah_order));
          std::vector<std::uint8_t> designed_order = occlusion_bits(designed_tree, s, in.sample);
          price_occlusion_bits(designed_tree, s, in.sample, in.costs, designed_order);
+         auto designed_stored = std::make_unique<Bvh>(s, "bvh-design", designed_tree, true);
+         designed_stored->set_any_stored(true);
          auto designed_ordered = std::make_unique<DesignedBvh>(s, std::move(designed_tree), std::move(designed_order));
-         // bvh-sah's tree takes its other rays alike with its order bytes or without (DesignedBvh
-         // orders occlusion rays only): replayed once.
+         // A tree takes its other rays alike with its order bytes or without (DesignedBvh orders
+         // occlusion rays only): replayed once.
          using Rays = designing::SampleReplay::Rays;
-         const RayCounters sah_others = replay.counters(*by_sah, Rays::Others);
-         RayCounters sah_ordered_whole = sah_others, sah_whole = sah_others;
-         sah_ordered_whole += replay.counters(*sah_ordered, Rays::Occlusion);
-         sah_whole += replay.counters(*by_sah, Rays::Occlusion);
-         const double c_designed = replay.time(*designed_ordered), c_sah_ordered = replay.time(*sah_ordered, sah_ordered_whole),
-                      c_sah = replay.time(*by_sah, sah_whole);
-         if (c_sah < c_designed && c_sah <= c_sah_ordered) return by_sah;
-         if (c_sah_ordered < c_designed) return sah_ordered;
-         return designed_ordered;
+         const RayCounters sah_others = replay.counters(*by_sah, Rays::Others),
+                           designed_others = replay.counters(*designed_stored, Rays::Others);
+         auto stored_time = [&](const Bvh& h, RayCounters whole) {
+             whole += replay.counters(h, Rays::Occlusion);
+             return replay.time(h, whole);
+         };
+         // The order bytes' walk decides at every node which child goes first, a branch the
+         // stored walk does not take: on rows of docs/design.md whose trees test as many
+         // operations either way (2026-12-06), it took 14-19% more ns per operation (tetra ao 190
+         // against 161 ns per ray, rings ao 309 against 266, tree ao 106 against 93, sombrero ao
+         // 243 against 211). Its occlusion rays' operations are priced that much dearer.
+         constexpr double kOrderedWalkPremium = 1.15;
+         auto ordered_time = [&](const DesignedBvh& h, RayCounters whole) {
+             const RayCounters occlusion = replay.counters(h, Rays::Occlusion);
+             whole += occlusion;
+             return replay.time(h, whole) +
+                    (kOrderedWalkPremium - 1) * (replay.time(h, occlusion) - replay.time(h, RayCounters{}));
+         };
+         const double c_designed_stored = stored_time(*designed_stored, designed_others),
+                      c_designed = ordered_time(*designed_ordered, designed_others),
+                      c_sah_ordered = ordered_time(*sah_ordered, sah_others), c_sah = stored_time(*by_sah, sah_others);
+         const double best = std::min({c_designed_stored, c_designed, c_sah_ordered, c_sah});
+         if (c_designed_stored == best) return designed_stored;
+         if (c_designed == best) return designed_ordered;
+         if (c_sah_ordered == best) return sah_ordered;
+         return by_sah;
      }}};
 
 }  // namespace
