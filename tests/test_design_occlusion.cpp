@@ -1,5 +1,5 @@
 // bvh-design's occlusion order (occlusion=sample): an order per node and direction from the sample,
-// on the designed tree or on bvh-sah's, and of those and bvh-sah walked front to back the one its
+// on the designed tree or on bvh-sah's, and of those trees with their orders or in stored order the one its
 // own walk of the sample prices cheapest; and the model's estimators taking that order from the
 // model tree (ModelNode::any_order).
 #include <gtest/gtest.h>

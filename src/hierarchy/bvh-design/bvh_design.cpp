@@ -6,8 +6,8 @@
 // where no split pays; and the order in which occlusion rays enter
 // a node's children: front to back, leaf children first or as stored, whichever the model predicts
 // cheapest on the sample (or, with occlusion=sample, an order per node and direction priced on the
-// sample, on the designed tree or on bvh-sah's, whichever its own walk prices cheaper on the sample:
-// occlusion_order.hpp).
+// sample, on the designed tree or on bvh-sah's; of those trees with their orders or in stored order,
+// whichever its own walk prices cheapest on the sample: occlusion_order.hpp).
 // Otherwise traversed as every BVH (../bvh/bvh.hpp).
 #include <algorithm>
 #include <optional>
@@ -254,9 +254,9 @@ const Registration reg{
              "order in which occlusion rays enter a node's children: near (front to back), leaves (leaf children "
              "first, then front to back), stored (first child first, unsorted: bvh-sah's default), auto (of near, "
              "leaves and stored, the one the model predicts cheapest on the sample), or sample (by node and by the "
-             "way the ray crosses it, the child whose order makes the subtree cheapest for the sample first, on the "
-             "designed tree or bvh-sah's, or bvh-sah front to back, whichever its walk prices cheapest on the "
-             "sample)"));
+             "way the ray crosses it, the child whose order makes the subtree cheapest for the sample first; of the "
+             "designed tree and bvh-sah's, each with those orders or stored, whichever its walk prices cheapest "
+             "on the sample, the orders' walk priced 15% dearer)"));
          p.push_back(ParamSpec::real("trust", "32", 0, 1e30,
                                      "sample segments at a node at which sample and surface area weigh alike "
                                      "(large: the surface area heuristic)"));
