@@ -1,7 +1,7 @@
 // bvh-design's occlusion order (occlusion=sample): an order per node and direction from the sample,
 // on the designed tree or on bvh-sah's, and of those trees with their orders or in stored order the one its
 // own walk of the sample prices cheapest; and the model's estimators taking that order from the
-// model tree (ModelNode::any_order).
+// model tree (ModelNode::any_order), or a whole tree's stored order (ModelTree::any_stored).
 #include <gtest/gtest.h>
 
 #include "../src/design/replay.hpp"
@@ -139,6 +139,57 @@ TEST(DesignOcclusion, ANodesOwnOrderIsModelledAsThatOrderStored) {
 // Without rays (isotropic lines, half going each way along any axis) the prediction is linear in
 // the share of lines a node enters first child first: a root entered first child first by every
 // line and one entered second child first by every line average to the random order of a root
+
+// A tree walked in stored order by its occlusion rays (ModelTree::any_stored: bvh-sah's default
+// any_order=stored) is modelled, for an any-hit query, as the same tree walked unordered, by every
+// estimator and by the per-ray model; and that is not what the tree walked nearest first predicts.
+// Traced, the ray counts what the probe of the tree says.
+TEST(DesignOcclusion, AStoredOrderIsModelledAsTheUnorderedWalkOfTheSameTree) {
+    const Scene s = load_scene("builtin:balls:3");
+    RaySpec spec;
+    spec.name = "shadow";
+    spec.size = "32x32";
+    auto ref = build_hierarchy(s, "bvh-sah", {"any_order=nearest"});
+    auto stored_bvh = build_hierarchy(s, "bvh-sah", {"any_order=stored"});
+    const ModelTree nearest = ref->model_tree();
+    ModelTree stored = nearest, unordered = nearest;
+    ASSERT_FALSE(nearest.any_stored);
+    stored.any_stored = true;
+    unordered.cull = false;
+    EXPECT_TRUE(stored_bvh->model_tree().any_stored);
+    const RaySample smp = draw_sample(s, spec, 512, 11, *ref);
+    ModelOptions any;
+    any.query = Query::Any;
+    const auto idx = indices(smp.size());
+    const Prediction a = predict_segments(stored, s, smp, idx, any), b = predict_segments(unordered, s, smp, idx, any),
+                     n = predict_segments(nearest, s, smp, idx, any);
+    EXPECT_NEAR(a.scalar, b.scalar, 1e-9 * b.scalar);
+    EXPECT_GT(std::fabs(a.scalar - n.scalar), 1e-3 * n.scalar);
+    const Prediction g = predict_geometric(stored, s, any), gu = predict_geometric(unordered, s, any);
+    EXPECT_NEAR(g.scalar, gu.scalar, 1e-9 * gu.scalar);
+    const RayCostModel ra(stored, s, smp, idx, any), rb(unordered, s, smp, idx, any), rn(nearest, s, smp, idx, any);
+    std::size_t differ = 0;
+    for (std::size_t i = 0; i < smp.size(); ++i) {
+        const Ray& r = smp.rays.rays[i];
+        const CostVector x = ra.predict(r), y = rb.predict(r), z = rn.predict(r);
+        ASSERT_NEAR(x.box, y.box, 1e-9 * (1 + y.box)) << "ray " << i;
+        ASSERT_NEAR(x.prim_tests(), y.prim_tests(), 1e-9 * (1 + y.prim_tests())) << "ray " << i;
+        differ += std::fabs(x.box - z.box) > 1e-6 * (1 + z.box);
+    }
+    EXPECT_GT(differ, smp.size() / 20);
+    // The probe of the stored tree with real tests is what tracing its rays counts.
+    std::vector<Ray> shadow;
+    for (std::size_t i = 0; i < smp.size(); ++i)
+        if (smp.queries[i] == Query::Any) shadow.push_back(smp.rays.rays[i]);
+    ASSERT_GT(shadow.size(), 100u);
+    const Prediction probe = predict_sampled(stored, s, shadow, any);
+    TraceOptions o;
+    o.query = Query::Any;
+    o.count = true;
+    o.threads = 1;
+    const double per_ray = UnitCosts{}.scalar(measured_cost(trace_rays(*stored_bvh, shadow, o).counters));
+    EXPECT_NEAR(probe.scalar, per_ray, 1e-6 * per_ray);
+}
 // without its own, as does a root whose order turns with the direction's sign.
 TEST(DesignOcclusion, TheGeometricModelTakesTheNodesOwnOrderAsTheShareOfLinesItOrders) {
     const Scene s = load_scene("builtin:balls:3");
