@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <utility>
 
+#include "../common/lanes_base.hpp"
 #include "wide.hpp"
 
 #if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
@@ -23,28 +24,8 @@ namespace avx2 {
 
 // Four lanes: a 4-wide node's boxes, and triangle packs of four (every leaf's with tri_lanes=4,
 // else a leaf's of at most four triangles, which would fill a pack of eight poorly and read
-// twice its bytes).
-struct P4 {
-    __m128 v;
-    static P4 load(const float* p) { return {_mm_load_ps(p)}; }
-    static P4 splat(float x) { return {_mm_set1_ps(x)}; }
-    static P4 sub(P4 a, P4 b) { return {_mm_sub_ps(a.v, b.v)}; }
-    static P4 mul(P4 a, P4 b) { return {_mm_mul_ps(a.v, b.v)}; }
-    static P4 add(P4 a, P4 b) { return {_mm_add_ps(a.v, b.v)}; }
-    static P4 div(P4 a, P4 b) { return {_mm_div_ps(a.v, b.v)}; }
-    static P4 abs(P4 a) { return {_mm_andnot_ps(_mm_set1_ps(-0.0f), a.v)}; }
-    static __m128 lt(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_LT_OQ); }
-    static __m128 gt(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_GT_OQ); }
-    static __m128 eq(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_EQ_OQ); }
-    static __m128 neq(P4 a, P4 b) { return _mm_cmp_ps(a.v, b.v, _CMP_NEQ_UQ); }  // true when unordered
-    static __m128 mand(__m128 a, __m128 b) { return _mm_and_ps(a, b); }
-    static __m128 mor(__m128 a, __m128 b) { return _mm_or_ps(a, b); }
-    static unsigned bits(__m128 m) { return static_cast<unsigned>(_mm_movemask_ps(m)); }
-    static P4 max(P4 a, P4 b) { return {_mm_max_ps(a.v, b.v)}; }  // a > b ? a : b
-    static P4 min(P4 a, P4 b) { return {_mm_min_ps(a.v, b.v)}; }  // a < b ? a : b
-    static unsigned le(P4 a, P4 b) { return static_cast<unsigned>(_mm_movemask_ps(_mm_cmple_ps(a.v, b.v))); }
-    void store(float* p) const { _mm_store_ps(p, v); }
-};
+// twice its bytes). The baseline's SSE lanes: inlined here, they are compiled for this target.
+using P4 = lanes::F4;
 
 struct P8 {
     __m256 v;
