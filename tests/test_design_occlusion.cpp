@@ -1,7 +1,7 @@
 // bvh-design's occlusion order (occlusion=sample): an order per node and direction from the sample,
 // on the designed tree or on bvh-sah's, and of those trees with their orders or in stored order the one its
 // own walk of the sample prices cheapest; and the model's estimators taking that order from the
-// model tree (ModelNode::any_order), or a whole tree's stored order (ModelTree::any_stored).
+// model tree (ModelNode::any_order), or a whole tree's stored order (OcclusionOrder::Stored).
 #include <gtest/gtest.h>
 
 #include "../src/design/replay.hpp"
@@ -140,7 +140,7 @@ TEST(DesignOcclusion, ANodesOwnOrderIsModelledAsThatOrderStored) {
 // the share of lines a node enters first child first: a root entered first child first by every
 // line and one entered second child first by every line average to the random order of a root
 
-// A tree walked in stored order by its occlusion rays (ModelTree::any_stored: bvh-sah's default
+// A tree walked in stored order by its occlusion rays (OcclusionOrder::Stored: bvh-sah's default
 // any_order=stored) is modelled, for an any-hit query, as the same tree walked unordered, by every
 // estimator and by the per-ray model; and that is not what the tree walked nearest first predicts.
 // Traced, the ray counts what the probe of the tree says.
@@ -153,10 +153,10 @@ TEST(DesignOcclusion, AStoredOrderIsModelledAsTheUnorderedWalkOfTheSameTree) {
     auto stored_bvh = build_hierarchy(s, "bvh-sah", {"any_order=stored"});
     const ModelTree nearest = ref->model_tree();
     ModelTree stored = nearest, unordered = nearest;
-    ASSERT_FALSE(nearest.any_stored);
-    stored.any_stored = true;
+    ASSERT_EQ(nearest.occlusion_order, OcclusionOrder::AsClosest);
+    stored.occlusion_order = OcclusionOrder::Stored;
     unordered.cull = false;
-    EXPECT_TRUE(stored_bvh->model_tree().any_stored);
+    EXPECT_EQ(stored_bvh->model_tree().occlusion_order, OcclusionOrder::Stored);
     const RaySample smp = draw_sample(s, spec, 512, 11, *ref);
     ModelOptions any;
     any.query = Query::Any;

@@ -196,9 +196,10 @@ TEST(Replay, OtherRaysCountAlikeInEveryOrderForOcclusionRays) {
             EXPECT_EQ(parts, replay.counters(*plain, Rays::All)) << where;
             EXPECT_DOUBLE_EQ(replay.time(*plain, parts), replay.time(*plain)) << where;
             EXPECT_GT(occlusion.box, 0u) << where;
-            plain->set_any_leaves_first(true);
+            const OcclusionOrder was = plain->occlusion_order();
+            plain->set_occlusion_order(OcclusionOrder::LeavesFirst);
             EXPECT_EQ(replay.counters(*plain, Rays::Others), others) << where;
-            plain->set_any_leaves_first(false);
+            plain->set_occlusion_order(was);
             const bvh::DesignedBvh ordered(s, plain->data(), bvh::occlusion_bits(plain->data(), s, in.sample));
             EXPECT_EQ(replay.counters(ordered, Rays::Others), others) << where;
             EXPECT_GT(others.box, 0u) << where;

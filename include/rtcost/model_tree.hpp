@@ -84,6 +84,18 @@ struct PaperCharges {
     bool far_entry = false;
 };
 
+/// How an any-hit (occlusion) query orders the children it meets, where the whole tree has one
+/// order (a node may have its own: ModelNode::any_order).
+enum class OcclusionOrder : std::uint8_t {
+    /// As a closest-hit query orders them (nearest entry first where the tree culls).
+    AsClosest,
+    /// Leaf children first (only a leaf can end the query), nearest entry first within leaves and
+    /// within interior nodes, a tie to the later child (`any_order=leaves`).
+    LeavesFirst,
+    /// In stored order, first child first, whatever their entries (`any_order=stored`).
+    Stored,
+};
+
 /// The flags of a model tree: what the nodes alone do not say about the traversal.
 struct ModelFlags {
     /// Every hierarchy names its family and the paper's charges: there is no default.
@@ -117,13 +129,8 @@ struct ModelFlags {
     /// A ray that misses the root's region ends at the root test (false: every ray enters the
     /// root whatever it meets, as brute force's does).
     bool gated = true;
-    /// An any-hit query visits the children it meets leaf children first (only a leaf can end
-    /// it), nearest entry first within leaves and within interior nodes, a tie to the later
-    /// child (bvh-wide's `any_order=leaves`); false: as a closest-hit query orders them.
-    bool any_leaves_first = false;
-    /// An any-hit query visits the children it meets in stored order, first child first, whatever
-    /// their entries (bvh-wide's `any_order=stored`); overrides any_leaves_first.
-    bool any_stored = false;
+    /// The order in which an any-hit query visits the children it meets.
+    OcclusionOrder occlusion_order = OcclusionOrder::AsClosest;
     /// A child whose region a stretch of the ray (not a single point) only touches -- the ray
     /// passing exactly through an edge or corner of its cell -- is entered: a grid's 3DDDA passes
     /// a corner one axis at a time. False: the traversal crosses an edge or corner in one step and

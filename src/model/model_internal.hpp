@@ -196,7 +196,7 @@ inline bool terminates(const ModelFlags& f, Query q) { return q == Query::Any ||
 /// Sorts the children a segment meets, (entry t, child index) with the child at `t.nodes[base +
 /// index]`, into the order an ordered traversal enters them: nearest first, a tie (a ray starting
 /// inside several) to the later child; with `leaves_first` (an any-hit query of a tree that
-/// declares ModelFlags::any_leaves_first) leaf children before interior ones.
+/// declares OcclusionOrder::LeavesFirst) leaf children before interior ones.
 inline void sort_children_met(std::span<std::pair<float, std::uint32_t>> met, const ModelTree& t, std::uint32_t base,
                               bool leaves_first) {
     std::sort(met.begin(), met.end(), [&](const auto& a, const auto& b) {

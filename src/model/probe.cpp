@@ -206,11 +206,11 @@ private:
                 if (t_.cull && sl.t0 == sr.t0 && t_.family == ModelFamily::Kd && m.axis >= 0 && m.axis < 3 &&
                     std::fabs(ri_.inv[m.axis]) < kInf)
                     left_first = !ri_.neg[m.axis];
-                if (any_ && t_.any_leaves_first) {
+                if (any_ && t_.occlusion_order == OcclusionOrder::LeavesFirst) {
                     const bool ll = t_.nodes[m.first].leaf, lr = t_.nodes[m.first + 1].leaf;
                     left_first = ll != lr ? ll : sl.t0 < sr.t0;
                 }
-                if (any_ && t_.any_stored) left_first = true;
+                if (any_ && t_.occlusion_order == OcclusionOrder::Stored) left_first = true;
                 if (any_ && (m.any_order & kAnyOrderSet)) left_first = any_order_first_child_first(m.any_order, ri_.neg);
                 ty.left_first += left_first;
                 const std::uint32_t near = left_first ? m.first : m.first + 1;
@@ -246,8 +246,8 @@ private:
                 const Segment sc = child(m.first + k, s);
                 if (!sc.empty()) met[nm++] = {sc.t0, m.first + k};
             }
-            const bool leaves_first = any_ && t_.any_leaves_first;
-            if ((t_.cull || leaves_first) && !(any_ && t_.any_stored))
+            const bool leaves_first = any_ && t_.occlusion_order == OcclusionOrder::LeavesFirst;
+            if ((t_.cull || leaves_first) && !(any_ && t_.occlusion_order == OcclusionOrder::Stored))
                 sort_children_met({met.data(), nm}, t_, 0, leaves_first);
             for (std::size_t k = 0; k < nm && !done(); ++k) {
                 const Segment sc = child(met[k].second, s);

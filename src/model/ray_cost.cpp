@@ -71,10 +71,10 @@ struct RayCostModel::Impl {
             segs[k] = sc;
             met[nm++] = {sc.t0, k};
         }
-        const bool leaves_first = any_query && tree.any_leaves_first;
+        const bool leaves_first = any_query && tree.occlusion_order == OcclusionOrder::LeavesFirst;
         if (any_query && (m.any_order & kAnyOrderSet)) {  // the node's own order (bvh-design's)
             if (nm == 2 && !any_order_first_child_first(m.any_order, ri.neg)) std::swap(met[0], met[1]);
-        } else if (any_query && tree.any_stored) {
+        } else if (any_query && tree.occlusion_order == OcclusionOrder::Stored) {
             // stored order: as met
         } else if (tree.cull && m.count == 2 && !leaves_first)  // a binary node's tie: the first child
             std::stable_sort(met.begin(), met.begin() + nm, [](auto& a, auto& b) { return a.first < b.first; });

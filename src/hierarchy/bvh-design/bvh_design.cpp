@@ -303,8 +303,9 @@ const Registration reg{
                  return o == Order::Near || (p.is("occlusion", "auto") && any_query);
              };
              auto set_order = [](Bvh& h, Order o) {
-                 h.set_any_leaves_first(o == Order::Leaves);
-                 h.set_any_stored(o == Order::Stored);
+                 h.set_occlusion_order(o == Order::Leaves   ? OcclusionOrder::LeavesFirst
+                                       : o == Order::Stored ? OcclusionOrder::Stored
+                                                            : OcclusionOrder::AsClosest);
              };
              struct Choice {
                  Bvh* h;
@@ -334,7 +335,7 @@ const Registration reg{
          // Each tree walked as bvh-sah walks it (occlusion rays in stored order) or with its order
          // bytes, the cheapest by its own traversal of the sample; a tie keeps the designed splits,
          // then the stored walk.
-         by_sah->set_any_stored(true);
+         by_sah->set_occlusion_order(OcclusionOrder::Stored);
          const designing::SampleReplay replay(s, in.sample, in.costs);
          std::vector<std::uint8_t> sah_order = occlusion_bits(by_sah->data(), s, in.sample);
          price_occlusion_bits(by_sah->data(), s, in.sample, in.costs, sah_order);
@@ -342,7 +343,7 @@ const Registration reg{
          std::vector<std::uint8_t> designed_order = occlusion_bits(designed_tree, s, in.sample);
          price_occlusion_bits(designed_tree, s, in.sample, in.costs, designed_order);
          auto designed_stored = std::make_unique<Bvh>(s, "bvh-design", designed_tree, true);
-         designed_stored->set_any_stored(true);
+         designed_stored->set_occlusion_order(OcclusionOrder::Stored);
          auto designed_ordered = std::make_unique<DesignedBvh>(s, std::move(designed_tree), std::move(designed_order));
          // A tree takes its other rays alike with its order bytes or without (DesignedBvh orders
          // occlusion rays only): replayed once.

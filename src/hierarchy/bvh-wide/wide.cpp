@@ -264,8 +264,9 @@ StructureStats BvhWide::compute_structure() const {
 bool BvhWide::emit_model(ModelSink& sink) const {
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     f.cull_widened = true;
-    f.any_leaves_first = d_->any_order == kAnyLeaves;
-    f.any_stored = d_->any_order == kAnyStored;
+    f.occlusion_order = d_->any_order == kAnyLeaves   ? OcclusionOrder::LeavesFirst
+                        : d_->any_order == kAnyStored ? OcclusionOrder::Stored
+                                                      : OcclusionOrder::AsClosest;
     if (!sink.begin(f) || d_->root_count == 0) return true;
     ModelNode root;
     root.region = root.bv = d_->root_box;

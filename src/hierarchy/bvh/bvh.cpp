@@ -32,8 +32,7 @@ bool Bvh::emit_model_ordered(ModelSink& sink, std::span<const std::uint8_t> any_
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     f.cull = ordered_;
     f.cull_widened = ordered_;
-    f.any_leaves_first = ordered_ && any_leaves_first_ && !any_stored_;
-    f.any_stored = ordered_ && any_stored_;
+    if (ordered_) f.occlusion_order = occlusion_;
     if (!sink.begin(f) || d_.nodes.empty()) return true;
     // Every builder lays leaves' references out depth first: a subtree's run of refs starts at
     // its leftmost leaf and ends with its rightmost.
@@ -72,8 +71,9 @@ namespace {
 std::unique_ptr<Bvh> ordered(const Scene& s, const char* name, BvhData data, const Params& p) {
     auto h = std::make_unique<Bvh>(s, name, std::move(data), !p.is("order", "none"));
     const bool leaves = p.is("order", "leaves") || p.is("any_order", "leaves");
-    h->set_any_leaves_first(leaves);
-    h->set_any_stored(!leaves && p.is("any_order", "stored"));
+    h->set_occlusion_order(leaves                         ? OcclusionOrder::LeavesFirst
+                           : p.is("any_order", "stored") ? OcclusionOrder::Stored
+                                                         : OcclusionOrder::AsClosest);
     return h;
 }
 

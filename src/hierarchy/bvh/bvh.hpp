@@ -74,18 +74,16 @@ public:
     bool emit_model_ordered(ModelSink& sink, std::span<const std::uint8_t> any_order) const;
     /// The built nodes and references (a traversal of another order reads them: bvh-design).
     const BvhData& data() const { return d_; }
-    /// Ordered any-hit (occlusion) queries enter a node's leaf children before its interior ones
-    /// (only a leaf can end the query), nearest first within each, a tie to the later child: a
-    /// large occluder held high in the tree (a floor, a wall) is tested before everything nearer.
-    void set_any_leaves_first(bool on) { any_leaves_first_ = on; }
-    bool any_leaves_first() const { return any_leaves_first_; }
-    /// Ordered any-hit (occlusion) queries take the children they meet in stored order, first
-    /// child first, with no comparison of their entries (as Embree's occlusion traversal): which
-    /// child holds an occluder is not told by which is nearer, and the comparison's branch is
+    /// The order of an ordered BVH's any-hit (occlusion) queries. LeavesFirst: a node's leaf
+    /// children before its interior ones (only a leaf can end the query), nearest first within
+    /// each, a tie to the later child: a large occluder held high in the tree (a floor, a wall) is
+    /// tested before everything nearer. Stored: the children met in stored order, first child
+    /// first, with no comparison of their entries (as Embree's occlusion traversal): which child
+    /// holds an occluder is not told by which is nearer, and the comparison's branch is
     /// mispredicted half the time (bvh-sah on balls-mesh's shadow rays: 10% faster for 3% more
-    /// steps; on rings-mesh's, 14% fewer steps). Overrides any_leaves_first.
-    void set_any_stored(bool on) { any_stored_ = on; }
-    bool any_stored() const { return any_stored_; }
+    /// steps; on rings-mesh's, 14% fewer steps).
+    void set_occlusion_order(OcclusionOrder o) { occlusion_ = o; }
+    OcclusionOrder occlusion_order() const { return occlusion_; }
 
     /// For another walk of the same nodes (bvh-design's occlusion order): leaf `n`'s primitive
     /// tests as this BVH's own walk makes them (with RealPrimTest, on its triangle copies in leaf
@@ -117,7 +115,8 @@ public:
         // Query::All never cuts by a hit found, which is the unordered walk.
         if constexpr (Q == Query::All) return walk<C, Q, false>(ray, hit, counting, test);
         // (An any-hit query ends at its first hit: the unordered walk is the ordered one in stored order.)
-        else if (ordered_ && !(Q == Query::Any && any_stored_)) return walk<C, Q, true>(ray, hit, counting, test);
+        else if (ordered_ && !(Q == Query::Any && occlusion_ == OcclusionOrder::Stored))
+            return walk<C, Q, true>(ray, hit, counting, test);
         else return walk<C, Q, false>(ray, hit, counting, test);
     }
 
@@ -197,9 +196,9 @@ private:
                     if (t != kInf) hits[nh++] = {n.index + k, t, e.depth + 1};
                 }
                 if constexpr (kOrdered) {
-                    // Nearest last, so it is popped first (any_leaves_first: leaves last, each
-                    // group nearest last). Fan-out is small: insertion sort.
-                    const bool leaves_first = Q == Query::Any && any_leaves_first_;
+                    // Nearest last, so it is popped first (LeavesFirst: leaves last, each group
+                    // nearest last). Fan-out is small: insertion sort.
+                    const bool leaves_first = Q == Query::Any && occlusion_ == OcclusionOrder::LeavesFirst;
                     auto taken_before = [&](const Entry& x, const Entry& y) {
                         if (leaves_first) {
                             const bool lx = nodes[x.node].leaf, ly = nodes[y.node].leaf;
@@ -271,11 +270,11 @@ private:
     }
 
     /// An ordered visit of a binary node: whether the second child (a leaf if `lb`, entered at
-    /// `tb`) goes first. Nearest first; any_leaves_first: a leaf child first, then the nearest,
+    /// `tb`) goes first. Nearest first; LeavesFirst: a leaf child first, then the nearest,
     /// a tie to the second child.
     template <Query Q>
     bool second_first(bool la, bool lb, float ta, float tb) const {
-        if (Q == Query::Any && any_leaves_first_) return la != lb ? lb : !(ta < tb);
+        if (Q == Query::Any && occlusion_ == OcclusionOrder::LeavesFirst) return la != lb ? lb : !(ta < tb);
         return tb < ta;
     }
 
@@ -294,8 +293,7 @@ private:
     std::string name_;
     BvhData d_;
     bool ordered_;
-    bool any_leaves_first_ = false;
-    bool any_stored_ = false;
+    OcclusionOrder occlusion_ = OcclusionOrder::AsClosest;
     std::vector<LeafPrim> prims_;  ///< BvhData::refs as their tests need them, in leaf order (none with packs_)
     LeafPacks packs_;              ///< the same in packs of four, for a mesh (every reference a triangle)
     bool has_triangles_ = false;    ///< some LeafPrim is tested as a triangle (RayShear needed)
