@@ -14,7 +14,7 @@ struct BvhWide::Data {
     Box3 root_box;
     std::uint32_t root_count = 0;
     int tri_lanes = 4;
-    int any_order = kAnyNearest;
+    OcclusionOrder any_order = OcclusionOrder::AsClosest;
     struct alignas(kLeafAlign) Block {
         std::byte b[kLeafAlign];
     };
@@ -264,9 +264,7 @@ StructureStats BvhWide::compute_structure() const {
 bool BvhWide::emit_model(ModelSink& sink) const {
     ModelFlags f(ModelFamily::Bvh, {.entered_box = 1});  // the paper: a box test per node entered
     f.cull_widened = true;
-    f.occlusion_order = d_->any_order == kAnyLeaves   ? OcclusionOrder::LeavesFirst
-                        : d_->any_order == kAnyStored ? OcclusionOrder::Stored
-                                                      : OcclusionOrder::AsClosest;
+    f.occlusion_order = d_->any_order;
     if (!sink.begin(f) || d_->root_count == 0) return true;
     ModelNode root;
     root.region = root.bv = d_->root_box;
@@ -328,7 +326,9 @@ std::unique_ptr<Hierarchy> build(const Scene& s, const Params& p) {
     }
     d->tri_lanes = use_avx2 && !p.is("tri_lanes", "4") ? 8 : 4;
     const std::string& ao = p.str("any_order");
-    d->any_order = ao == "nearest" ? kAnyNearest : ao == "leaves" ? kAnyLeaves : kAnyStored;
+    d->any_order = ao == "nearest"  ? OcclusionOrder::AsClosest
+                   : ao == "leaves" ? OcclusionOrder::LeavesFirst
+                                    : OcclusionOrder::Stored;
     if (d->width == 8) {
         if (d->tri_lanes == 8) pack_leaves<8, 8>(*d, d->n8, bd, s);
         else pack_leaves<8, 4>(*d, d->n8, bd, s);

@@ -66,18 +66,15 @@ struct View {
     const std::byte* leaves = nullptr;
     int tri_lanes = 4;  ///< 4 for the baseline traversal, 4 or 8 for AVX2
     const Scene* scene = nullptr;
-    /// Order of the children met in any-hit queries: AnyOrder.
-    int any_order = 0;
+    /// Order in which an any-hit query visits the children a node's slab test met. AsClosest:
+    /// nearest first. LeavesFirst: leaf children first (only a leaf can end the query), nearest
+    /// first within leaves and within interior nodes: occlusion by a large primitive held high in
+    /// the tree (a wall or floor over the whole scene) is then found at the top instead of after
+    /// everything nearer along the ray. Stored: in the node's order, first child first, with no
+    /// sort at all (as Embree's occlusion traversal): any occluder ends the query, so ordering
+    /// buys little, and the sort was 6-9% of a mesh's shadow rays.
+    OcclusionOrder any_order = OcclusionOrder::AsClosest;
 };
-
-/// Order in which an any-hit query visits the children a node's slab test met. Nearest: nearest
-/// first, as closest-hit queries. Leaves: leaf children first (only a leaf can end the query),
-/// nearest first within leaves and within interior nodes. Occlusion by a large primitive held
-/// high in the tree (a wall or floor over the whole scene) is then found at the top instead of
-/// after everything nearer along the ray. Stored: in the node's order, first child first, with
-/// no sort at all (as Embree's occlusion traversal): any occluder ends the query, so ordering
-/// buys little, and the sort was 6-9% of a mesh's shadow rays.
-enum AnyOrder : int { kAnyNearest = 0, kAnyLeaves = 1, kAnyStored = 2 };
 
 /// One traversal instantiation: closest, any or all, with or without counting. The last
 /// argument is null but in a replay, which answers every primitive test from the ray's known
