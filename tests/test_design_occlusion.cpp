@@ -4,6 +4,8 @@
 // model tree (ModelNode::any_order), or a whole tree's stored order (OcclusionOrder::Stored).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "../src/design/replay.hpp"
 #include "../src/hierarchy/bvh-design/occlusion_order.hpp"
 #include "rtcost/design.hpp"
@@ -32,6 +34,16 @@ double ops_on_sample(const Hierarchy& h, const RaySample& smp) {
         sum += r.counters;
     }
     return UnitCosts{}.scalar(measured_cost(sum));  // unit costs, per ray: sum.rays of them
+}
+
+// Each of the sample's rays costs, box tests and primitive tests, the same by the per-ray models
+// `a` and `b`.
+void expect_same_per_ray(const RayCostModel& a, const RayCostModel& b, const RaySample& smp) {
+    for (std::size_t i = 0; i < smp.size(); ++i) {
+        const CostVector x = a.predict(smp.rays.rays[i]), y = b.predict(smp.rays.rays[i]);
+        ASSERT_NEAR(x.box, y.box, 1e-9 * (1 + y.box)) << "ray " << i;
+        ASSERT_NEAR(x.prim_tests(), y.prim_tests(), 1e-9 * (1 + y.prim_tests())) << "ray " << i;
+    }
 }
 
 TEST(DesignOcclusion, TheOrderChosenCountsNoMoreOnItsSampleThanFrontToBack) {
@@ -128,17 +140,8 @@ TEST(DesignOcclusion, ANodesOwnOrderIsModelledAsThatOrderStored) {
     EXPECT_NEAR(a.cost.box, b.cost.box, 1e-9 * b.cost.box);
     EXPECT_NEAR(a.cost.prim_tests(), b.cost.prim_tests(), 1e-9 * b.cost.prim_tests());
     EXPECT_GT(std::fabs(a.scalar - nearest.scalar), 1e-3 * nearest.scalar);  // the order matters here
-    const RayCostModel ra(second, s, smp, idx, any), rb(swapped, s, smp, idx, any);
-    for (std::size_t i = 0; i < smp.size(); ++i) {
-        const CostVector x = ra.predict(smp.rays.rays[i]), y = rb.predict(smp.rays.rays[i]);
-        ASSERT_NEAR(x.box, y.box, 1e-9 * (1 + y.box)) << "ray " << i;
-        ASSERT_NEAR(x.prim_tests(), y.prim_tests(), 1e-9 * (1 + y.prim_tests())) << "ray " << i;
-    }
+    expect_same_per_ray(RayCostModel(second, s, smp, idx, any), RayCostModel(swapped, s, smp, idx, any), smp);
 }
-
-// Without rays (isotropic lines, half going each way along any axis) the prediction is linear in
-// the share of lines a node enters first child first: a root entered first child first by every
-// line and one entered second child first by every line average to the random order of a root
 
 // A tree walked in stored order by its occlusion rays (OcclusionOrder::Stored: bvh-sah's default
 // any_order=stored) is modelled, for an any-hit query, as the same tree walked unordered, by every
@@ -167,29 +170,24 @@ TEST(DesignOcclusion, AStoredOrderIsModelledAsTheUnorderedWalkOfTheSameTree) {
     EXPECT_GT(std::fabs(a.scalar - n.scalar), 1e-3 * n.scalar);
     const Prediction g = predict_geometric(stored, s, any), gu = predict_geometric(unordered, s, any);
     EXPECT_NEAR(g.scalar, gu.scalar, 1e-9 * gu.scalar);
-    const RayCostModel ra(stored, s, smp, idx, any), rb(unordered, s, smp, idx, any), rn(nearest, s, smp, idx, any);
+    const RayCostModel ra(stored, s, smp, idx, any), rn(nearest, s, smp, idx, any);
+    expect_same_per_ray(ra, RayCostModel(unordered, s, smp, idx, any), smp);
     std::size_t differ = 0;
-    for (std::size_t i = 0; i < smp.size(); ++i) {
-        const Ray& r = smp.rays.rays[i];
-        const CostVector x = ra.predict(r), y = rb.predict(r), z = rn.predict(r);
-        ASSERT_NEAR(x.box, y.box, 1e-9 * (1 + y.box)) << "ray " << i;
-        ASSERT_NEAR(x.prim_tests(), y.prim_tests(), 1e-9 * (1 + y.prim_tests())) << "ray " << i;
-        differ += std::fabs(x.box - z.box) > 1e-6 * (1 + z.box);
+    for (const Ray& r : smp.rays.rays) {
+        const double x = ra.predict(r).box, z = rn.predict(r).box;
+        differ += std::fabs(x - z) > 1e-6 * (1 + z);
     }
     EXPECT_GT(differ, smp.size() / 20);
-    // The probe of the stored tree with real tests is what tracing its rays counts.
-    std::vector<Ray> shadow;
-    for (std::size_t i = 0; i < smp.size(); ++i)
-        if (smp.queries[i] == Query::Any) shadow.push_back(smp.rays.rays[i]);
-    ASSERT_GT(shadow.size(), 100u);
-    const Prediction probe = predict_sampled(stored, s, shadow, any);
-    TraceOptions o;
-    o.query = Query::Any;
-    o.count = true;
-    o.threads = 1;
-    const double per_ray = UnitCosts{}.scalar(measured_cost(trace_rays(*stored_bvh, shadow, o).counters));
-    EXPECT_NEAR(probe.scalar, per_ray, 1e-6 * per_ray);
+    // The probe of the stored tree with real tests is what tracing its rays counts (every ray of
+    // the sample is a shadow ray, traced with its own query).
+    ASSERT_EQ(std::count(smp.queries.begin(), smp.queries.end(), Query::Any), static_cast<std::ptrdiff_t>(smp.size()));
+    const double per_ray = ops_on_sample(*stored_bvh, smp);
+    EXPECT_NEAR(predict_sampled(stored, s, smp.rays.rays, any).scalar, per_ray, 1e-6 * per_ray);
 }
+
+// Without rays (isotropic lines, half going each way along any axis) the prediction is linear in
+// the share of lines a node enters first child first: a root entered first child first by every
+// line and one entered second child first by every line average to the random order of a root
 // without its own, as does a root whose order turns with the direction's sign.
 TEST(DesignOcclusion, TheGeometricModelTakesTheNodesOwnOrderAsTheShareOfLinesItOrders) {
     const Scene s = load_scene("builtin:balls:3");
