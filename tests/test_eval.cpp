@@ -108,6 +108,8 @@ TEST(EvalRun, BruteForceIsPredictedOnRaysThatMissTheScene) {
     EXPECT_NEAR(b.measured.prim_tests(), double(s.size()), 1e-9);
     for (const Prediction& p : b.predictions)
         EXPECT_NEAR(p.cost.prim_tests(), double(s.size()), 0.02 * s.size()) << p.estimator;
+    // The segments sample's rays are traced too, for what they cost a trace.
+    for (const EvalRow& row : r.rows) EXPECT_GT(row.sample_trace_seconds, 0) << row.name;
 }
 
 TEST(EvalView, CameraAndLightsFromOptionsAndBadOnesRefused) {

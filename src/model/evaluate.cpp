@@ -287,6 +287,23 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                     if (est == Estimator::Geometric && seen) row.predictions.back().seconds += grow_seconds;
                 }
             }
+            // The segments sample's own rays traced once (real tests, not counted), right after its
+            // prediction replayed them: what its rays cost a trace, against what replaying them
+            // cost (a few thousand rays spread over the whole distribution, far less coherent
+            // than the distribution traced in its order).
+            if (segments) {
+                const auto start = std::chrono::steady_clock::now();
+                for (int k = 0; k < kRayKinds; ++k) {
+                    if (test_kinds[k].empty() || sample_kinds[k].empty()) continue;
+                    std::vector<Ray> rays;
+                    for (std::uint32_t i : sample_kinds[k]) rays.push_back(sample->rays.rays[i]);
+                    TraceOptions t;
+                    t.query = query_of(k);
+                    t.threads = 1;
+                    trace_rays(*h, rays, t);
+                }
+                row.sample_trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            }
         }
         row.measured = measured_cost(counted.counters);
         // The time model prices what the structure is as well as what it does (its SIMD box

@@ -63,6 +63,7 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
             j["error"] = row.error;
             j["rank_predicted"] = row.rank_predicted;
             j["seconds_predicting"] = head->seconds;
+            if (row.sample_trace_seconds > 0) j["sample_trace_seconds"] = row.sample_trace_seconds;
             j["note"] = head->note + (row.lazy ? "; lazily built: modelled over the beams built by the rays so far" : "");
             if (row.predictions.size() > 1) {
                 json all = json::array();
