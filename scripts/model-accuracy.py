@@ -102,6 +102,7 @@ def main():
 
     # (scene, dist, hierarchy, measured, {est: (pred, err, seconds)}, trace_seconds,
     #  seconds of one trace of the segments sample's own rays, sample / population)
+    rows = []
     runs = []   # (scene, dist, rays, sample, training, {est: rho})
     for scene, path in scenes:
         for dist in a.dists.split(","):
@@ -202,7 +203,7 @@ def main():
                     " | ".join(f"{rho[e]:.3f}" for e in ESTIMATORS) + " |\n")
         f.write("\n## Predicted against measured operations per ray\n\n| scene | distribution | hierarchy | "
                 "measured | " + " | ".join(ESTIMATORS) + " |\n|---|---|---|---|" + "---|" * len(ESTIMATORS) + "\n")
-        for scene, dist, h, meas, p, _ in rows:
+        for scene, dist, h, meas, p, *_ in rows:
             f.write(f"| {scene} | {dist} | {h} | {meas:.1f} | " +
                     " | ".join(f"{p[e][0]:.1f} ({100 * p[e][1]:+.1f}%)" for e in ESTIMATORS) + " |\n")
     os.replace(a.out + ".tmp", a.out)

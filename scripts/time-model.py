@@ -9,7 +9,7 @@ every scene is predicted once without having been fitted. For each fold, `calibr
 and `calibrate` (every term) run one after the other, pinned to core 0 (side by side, one per
 core, the two shared the cache and the memory bus, and each timed the other's passes too).
 
-Usage: python3 scripts/time-model.py [--size 128x128] [--rays spd] [--out docs/time-model.md]
+Usage: python3 scripts/time-model.py [--size 128x128] [--rays spd] [--out docs/time-model.md] [--keep DIR]
 Needs build/rtcost, ../shared/scenes/spd and Debian's assimp-testmodels (the two meshes).
 """
 import argparse
@@ -61,6 +61,7 @@ def main():
     ap.add_argument("--size", default="128x128")
     ap.add_argument("--rays", default="spd")
     ap.add_argument("--out", default=os.path.join(ROOT, "docs", "time-model.md"))
+    ap.add_argument("--keep", metavar="DIR", help="also write each calibration's JSON into DIR")
     args = ap.parse_args()
     for s in HALVES[0] + HALVES[1]:
         if not os.path.exists(path_of(s)):
@@ -74,6 +75,10 @@ def main():
             print(f"fold {fold + 1}: fit on {', '.join(fit)}", file=sys.stderr)
             for label, terms in MODELS:
                 results[label][fold] = calibrate(fit, held, terms, 0, args, os.path.join(tmp, f"costs-{fold}.json"))
+                if args.keep:
+                    os.makedirs(args.keep, exist_ok=True)
+                    with open(os.path.join(args.keep, f"fold{fold + 1}-{terms.replace(',', '-')}.json"), "w") as k:
+                        json.dump(results[label][fold], k, indent=1)
 
     # Per scene: rho and mean absolute error under each model; per hierarchy: mean absolute error.
     scenes = HALVES[1] + HALVES[0]  # fold 1 holds out HALVES[1]
