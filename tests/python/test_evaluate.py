@@ -7,7 +7,8 @@ import rtcost
 from conftest import cli_json, run_cli
 
 SCENE = "builtin:tetra:4"
-TIMES = {"mrays_per_s", "time", "seconds_predicting", "seconds", "sample_seconds", "visibility_seconds"}
+TIMES = {"mrays_per_s", "time", "seconds_predicting", "seconds", "sample_seconds", "visibility_seconds",
+         "sample_trace_seconds"}
 
 
 def without_times(value):

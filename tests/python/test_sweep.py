@@ -16,7 +16,7 @@ SPEC = {
     "distributions": [{"dist": "lines", "count": 2000, "seed": 4}, {"dist": "camera", "size": "16x16"}],
     "threads": 1,
 }
-TIMES = {"seconds", "mrays_per_s", "time", "seconds_predicting", "sample_seconds"}
+TIMES = {"seconds", "mrays_per_s", "time", "seconds_predicting", "sample_seconds", "sample_trace_seconds"}
 
 
 def without_times(value):
