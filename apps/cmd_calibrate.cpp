@@ -107,6 +107,7 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         fit["per_ray"] = c.costs.per_ray;
         fit["step"] = terms.steps ? json(c.costs.step) : json(nullptr);
         fit["box_simd"] = c.costs.box_simd >= 0 ? json(c.costs.box_simd) : json(nullptr);
+        fit["box_pair"] = c.costs.box_pair >= 0 ? json(c.costs.box_pair) : json(nullptr);
         fit["cache"] = terms.cache ? json(c.costs.cache) : json(nullptr);
         fit["cache_bytes"] = c.costs.cache_bytes;
         fit["polygon_edge"] = terms.edges ? json(c.costs.polygon_edge) : json(nullptr);
@@ -143,6 +144,10 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         fmt::print("  {:<10} {}\n", "box simd",
                    c.costs.box_simd >= 0 ? fmt::format("{:.3f} (per box test of a SIMD node visit)", c.costs.box_simd)
                                          : "(no SIMD structure measured: priced as box)");
+    if (terms.simd)
+        fmt::print("  {:<10} {}\n", "box pair",
+                   c.costs.box_pair >= 0 ? fmt::format("{:.3f} (per box test of a binary node's pair)", c.costs.box_pair)
+                                         : "(no binary BVH measured: priced as box)");
     if (terms.cache)
         fmt::print("  {:<10} {:.3f} (per step, per doubling of the structure beyond {})\n", "cache", c.costs.cache,
                    human_bytes(static_cast<std::uint64_t>(c.costs.cache_bytes)));
@@ -189,7 +194,7 @@ Subcommand setup_calibrate(CLI::App& parent, Common& common) {
     cmd->add_option("-o,--out", a->out, "costs file to write")->capture_default_str();
     cmd->add_option("--terms", a->terms,
                     "time model: ops (operations and a fixed cost per ray, always), steps (ns per traversal step), "
-                    "simd (box tests of SIMD node visits priced apart), cache (ns per step per doubling of the "
+                    "simd (box tests made several at once priced apart: a SIMD node visit's, a binary node's pair), cache (ns per step per doubling of the "
                     "structure beyond the L2 cache), edges (ns per edge a polygon test walks, polygons of more "
                     "than three vertices)")
         ->capture_default_str();

@@ -58,18 +58,18 @@ TEST(Calibrate, RecoversKnownUnitCostsAndKeepsThemNonNegative) {
 }
 
 TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
-    // Runs timed by a known time model: per step, SIMD box tests priced apart, and a cache term
-    // for structures beyond 1 MiB. The fit must give every term back.
+    // Runs timed by a known time model: per step, SIMD box tests and binary nodes' pairs priced
+    // apart, and a cache term for structures beyond 1 MiB. The fit must give every term back.
     UnitCosts truth;
     truth.box = 3; truth.plane = 5; truth.hop = 0; truth.classify = 0; truth.per_ray = 20;
     truth.prim = {12, 30, 0, 0};
-    truth.step = 6; truth.box_simd = 0.5; truth.cache = 2; truth.cache_bytes = 1 << 20;
+    truth.step = 6; truth.box_simd = 0.5; truth.box_pair = 1.5; truth.cache = 2; truth.cache_bytes = 1 << 20;
     std::vector<CalibrationSample> runs = timed_runs(truth, 16, [&](int i, CalibrationSample& s) {
         s.ops.box = 4 + 5 * (i % 7);
         s.ops.plane = (i % 3) * 6.0;
         s.ops.steps = 3 + (i * 5) % 11;
         s.ops.prim = {1.0 + i % 4, (i % 2) * 3.0, 0, 0};
-        s.structure.box_lanes = i % 4 == 3 ? 8 : 1;
+        s.structure.box_lanes = i % 4 == 3 ? 8 : i % 4 == 1 ? 2 : 1;
         s.structure.bytes = std::uint64_t(1) << (16 + i % 9);  // 64 KiB .. 16 MiB
     });
     Calibration c = calibrate(runs, {}, 1 << 20);
@@ -77,6 +77,7 @@ TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
     EXPECT_NEAR(c.costs.plane, 5, 1e-6);
     EXPECT_NEAR(c.costs.step, 6, 1e-6);
     EXPECT_NEAR(c.costs.box_simd, 0.5, 1e-6);
+    EXPECT_NEAR(c.costs.box_pair, 1.5, 1e-6);
     EXPECT_NEAR(c.costs.cache, 2, 1e-6);
     EXPECT_NEAR(c.costs.per_ray, 20, 1e-5);
     EXPECT_NEAR(c.rms_relative, 0, 1e-9);
@@ -85,12 +86,24 @@ TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
     EXPECT_GT(ops.rms_relative, 0.01);
     EXPECT_EQ(ops.costs.step, 0);
     EXPECT_LT(ops.costs.box_simd, 0);  // not fitted: priced as box
-    EXPECT_FALSE(ops.fitted[ops.fitted.size() - 4]);  // step
+    EXPECT_LT(ops.costs.box_pair, 0);
+    EXPECT_FALSE(ops.fitted[ops.fitted.size() - 5]);  // step
     EXPECT_FALSE(ops.fitted.back());                  // polygon_edge
-    // No SIMD structure among the runs: box_simd stays unfitted.
+    // Every box test in pairs (binary BVHs alone): box_pair is fitted, and a box test priced
+    // without its structure costs the same, not the 0 of an unexercised kind.
+    for (auto& s : runs) s.structure.box_lanes = 2;
+    for (auto& s : runs) s.ns_per_ray = truth.scalar(s.ops, s.structure);
+    Calibration pairs = calibrate(runs, {}, 1 << 20);
+    EXPECT_NEAR(pairs.costs.box_pair, 1.5, 1e-6);
+    EXPECT_NEAR(pairs.costs.box, 1.5, 1e-6);
+    EXPECT_FALSE(pairs.fitted[0]);
+    // No SIMD structure among the runs: box_simd and box_pair stay unfitted.
     for (auto& s : runs) s.structure.box_lanes = 1;
     for (auto& s : runs) s.ns_per_ray = truth.scalar(s.ops, s.structure);
-    EXPECT_LT(calibrate(runs, {}, 1 << 20).costs.box_simd, 0);
+    const Calibration scalar = calibrate(runs, {}, 1 << 20);
+    EXPECT_LT(scalar.costs.box_simd, 0);
+    EXPECT_LT(scalar.costs.box_pair, 0);
+    EXPECT_NEAR(scalar.costs.box, 3, 1e-6);
 }
 
 TEST(Calibrate, AKindTheRunsCannotTellFromAnotherIsNotPricedAtZero) {

@@ -324,6 +324,14 @@ TEST(UnitCosts, TheTimeModelPricesSimdBoxTestsAndTheCacheByTheStructure) {
     EXPECT_DOUBLE_EQ(u.scalar(c, small), 20 + 12 + 20);
     // 64 MiB is two doublings beyond 16 MiB: 2 x 4 steps x 1 ns; boxes at 0.5 ns.
     EXPECT_DOUBLE_EQ(u.scalar(c, wide), 5 + 12 + 20 + 8);
+    // A binary BVH's pairs at box_pair once it is known; as any box test before.
+    StructureStats binary;
+    binary.box_lanes = 2;
+    binary.bytes = 1u << 20;
+    EXPECT_DOUBLE_EQ(u.scalar(c, binary), 20 + 12 + 20);
+    u.box_pair = 1;
+    EXPECT_DOUBLE_EQ(u.scalar(c, binary), 10 + 12 + 20);
+    EXPECT_DOUBLE_EQ(u.scalar(c, wide), 5 + 12 + 20 + 8);
     EXPECT_DOUBLE_EQ(u.cache_doublings(16u << 20), 0);
     EXPECT_DOUBLE_EQ(u.cache_doublings(32u << 20), 1);
 }
@@ -344,10 +352,12 @@ TEST(UnitCosts, ReadsACostsFileAndRejectsBadOnes) {
     EXPECT_LT(u.box_simd, 0);  // a file without the time model's terms prices every box alike
     EXPECT_EQ(u.step, 0);
     auto full = dir / "rtcost_costs_full.json";
-    std::ofstream(full) << R"({"unit": "ns", "box": 2, "step": 4, "box_simd": 0.25, "cache": 1.5, "cache_bytes": 524288})";
+    std::ofstream(full) << R"({"unit": "ns", "box": 2, "step": 4, "box_simd": 0.25, "box_pair": 1.25, "cache": 1.5, "cache_bytes": 524288})";
     UnitCosts f = UnitCosts::read(full.string());
     EXPECT_EQ(f.step, 4);
     EXPECT_EQ(f.box_simd, 0.25);
+    EXPECT_EQ(f.box_pair, 1.25);
+    EXPECT_LT(u.box_pair, 0);
     EXPECT_EQ(f.cache, 1.5);
     EXPECT_EQ(f.cache_bytes, 524288);
     std::ofstream(full) << R"({"unit": "ns", "box": 2, "step": -4})";

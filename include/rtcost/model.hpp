@@ -35,16 +35,21 @@ void add_scaled(CostVector& y, const CostVector& x, double w);
 /// Cost of one operation of each kind (default 1: pure operation counts; calibrated: ns).
 ///
 /// A calibrated time model may also charge what no single operation explains: each traversal
-/// step (the loop, the stack, the fetch of a node), box tests that a node's SIMD visit makes
-/// several at once (StructureStats::box_lanes > 1: bvh-wide), and the cache misses of a structure
+/// step (the loop, the stack, the fetch of a node), box tests that a node's visit makes several
+/// at once (StructureStats::box_lanes: bvh-wide's SIMD visit, a binary BVH's pair of children),
+/// and the cache misses of a structure
 /// larger than the cache. Unit costs charge none of these, so operation counts stay counts.
 struct UnitCosts {
     double box = 1, plane = 1, hop = 1, classify = 1;
     std::array<double, kPrimKinds> prim{1, 1, 1, 1};
     double per_ray = 0;       ///< fixed cost of every ray (calibrated files: setup, clip, loop)
     double step = 0;          ///< per traversal step (CostVector::steps), besides its operations
-    /// Per box test of a structure whose box tests are SIMD (box_lanes > 1); negative: as `box`.
+    /// Per box test of a structure whose box tests are SIMD (box_lanes of 4 or more: bvh-wide);
+    /// negative: as `box`.
     double box_simd = -1;
+    /// Per box test of a structure that tests two boxes at once (box_lanes 2: the binary BVHs);
+    /// negative: as `box`.
+    double box_pair = -1;
     /// Per traversal step, for each doubling of the structure's bytes beyond `cache_bytes`: the
     /// memory a step waits on once the structure no longer fits in the cache.
     double cache = 0;
@@ -63,9 +68,10 @@ struct UnitCosts {
     /// The cache term's factor: log2(bytes / cache_bytes), 0 for a structure that fits.
     double cache_doublings(std::uint64_t bytes) const;
     /// Reads a costs file (JSON `{"unit": "ns", "box": ns, "plane": ns, ..., "per_ray": ns,
-    /// "step": ns, "box_simd": ns, "cache": ns, "cache_bytes": bytes, "polygon_edge": ns, "prim":
-    /// {"triangle": ns, ...}}`; the time model's terms are optional: `box_simd` then prices SIMD
-    /// box tests as `box`, `step`, `cache` and `polygon_edge` are 0).
+    /// "step": ns, "box_simd": ns, "box_pair": ns, "cache": ns, "cache_bytes": bytes,
+    /// "polygon_edge": ns, "prim": {"triangle": ns, ...}}`; the time model's terms are optional:
+    /// `box_simd` and `box_pair` then price those box tests as `box`, `step`, `cache` and
+    /// `polygon_edge` are 0).
     static UnitCosts read(const std::string& path);
     /// Typical nanoseconds per operation, built in: what the designed hierarchies minimise
     /// unless told otherwise, because operation counts alone trade box tests for primitive
@@ -101,7 +107,8 @@ struct CalibrationSample {
 /// Which terms a calibration fits besides the operations and the fixed cost per ray.
 struct TimeTerms {
     bool steps = true;  ///< UnitCosts::step
-    bool simd = true;   ///< UnitCosts::box_simd (else SIMD box tests are priced as any box test)
+    /// UnitCosts::box_simd and box_pair (else box tests made several at once are priced as any)
+    bool simd = true;
     bool cache = true;  ///< UnitCosts::cache
     /// UnitCosts::polygon_edge, timed on this machine's crossing test (not fitted: see
     /// calibrate.cpp) and taken out of each run's time before the rest is fitted.
@@ -111,7 +118,7 @@ struct TimeTerms {
 struct Calibration {
     UnitCosts costs;                ///< fitted ns per operation (calibrated = true)
     std::vector<double> predicted;  ///< fitted ns per ray for each sample
-    /// Unknowns (box, plane, hop, classify, prims..., per_ray, step, box_simd, cache,
+    /// Unknowns (box, plane, hop, classify, prims..., per_ray, step, box_simd, cache, box_pair,
     /// polygon_edge: the last, timed on polygons rather than fitted) the data
     /// determined.
     std::vector<bool> fitted;
@@ -120,7 +127,7 @@ struct Calibration {
 
 /// Non-negative least squares of ns_per_ray = UnitCosts::scalar(ops, structure), each sample
 /// weighted by 1 / ns_per_ray (relative errors count alike). Kinds that no sample performs keep
-/// cost 0 and are reported as not fitted (box_simd: -1, priced as `box`). `cache_bytes`: the cache
+/// cost 0 and are reported as not fitted (box_simd, box_pair: -1, priced as `box`). `cache_bytes`: the cache
 /// the cache term counts doublings beyond (0: this machine's L2). The primitive prices are then
 /// fitted again, each pulled toward the mean of the kinds tested with the weight of the first
 /// fit's rms relative residual (runs that a time model explains exactly are not moved; a price

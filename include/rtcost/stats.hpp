@@ -96,8 +96,9 @@ struct StructureStats {
     std::uint64_t references = 0;   ///< N_OIV: primitive references in leaves
     int depth = 0;                  ///< deepest leaf (root at depth 0)
     std::uint64_t bytes = 0;        ///< memory of the structure itself (not the scene)
-    /// Box tests one SIMD test makes at once in a node visit (bvh-wide: its width); 1: one at a
-    /// time. Counted box tests are the same either way; the time model prices them apart.
+    /// Box tests one SIMD test makes at once in a node visit (bvh-wide: its width; 2: a binary
+    /// BVH's two children in one test); 1: one at a time (bvh-gs's n-ary nodes). Counted box
+    /// tests are the same either way; the time model prices them apart.
     int box_lanes = 1;
     double seconds = 0;             ///< build time
     /// Bounds on time or memory that stopped the build short of what its parameters asked

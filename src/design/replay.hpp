@@ -75,7 +75,7 @@ public:
     /// its occlusion rays' added up).
     template <class H>
     double time(const H& h, RayCounters whole) const {
-        const bool sized = costs_.cache > 0 || costs_.box_simd >= 0;
+        const bool sized = costs_.cache > 0 || costs_.box_simd >= 0 || costs_.box_pair >= 0;
         whole.rays = sample_.size();
         return costs_.scalar(measured_cost(whole), sized ? h.structure() : StructureStats{});
     }

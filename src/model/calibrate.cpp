@@ -17,10 +17,11 @@
 namespace rtcost {
 namespace {
 
-// box, plane, hop, classify, prims, per_ray, then the time model's step, box_simd, cache and
-// polygon_edge (timed, not fitted: polygon_edge_ns).
+// box, plane, hop, classify, prims, per_ray, then the time model's step, box_simd, cache, box_pair
+// and polygon_edge (timed, not fitted: polygon_edge_ns).
 constexpr int kOps = 4 + kPrimKinds + 1;
-constexpr int kStep = kOps, kBoxSimd = kOps + 1, kCache = kOps + 2, kEdge = kOps + 3, kUnknowns = kOps + 4;
+constexpr int kStep = kOps, kBoxSimd = kOps + 1, kCache = kOps + 2, kBoxPair = kOps + 3, kEdge = kOps + 4,
+              kUnknowns = kOps + 5;
 
 }  // namespace
 
@@ -83,8 +84,9 @@ namespace {
 std::array<double, kUnknowns> row_of(const CalibrationSample& s, const TimeTerms& terms, const UnitCosts& shape) {
     const CostVector& c = s.ops;
     std::array<double, kUnknowns> r{};
-    const bool simd = terms.simd && s.structure.box_lanes > 1;
-    (simd ? r[kBoxSimd] : r[0]) = c.box;
+    // Box tests made several at once: a SIMD node visit's (bvh-wide), a binary node's pair.
+    const int lanes = terms.simd ? s.structure.box_lanes : 1;
+    r[lanes >= 4 ? kBoxSimd : lanes == 2 ? kBoxPair : 0] = c.box;
     r[1] = c.plane;
     r[2] = c.hop;
     r[3] = c.classify;
@@ -254,6 +256,10 @@ Calibration calibrate(std::span<const CalibrationSample> samples, const TimeTerm
     c.costs.per_ray = x[kOps - 1];
     c.costs.step = x[kStep];
     c.costs.box_simd = usable[kBoxSimd] ? x[kBoxSimd] : -1;
+    c.costs.box_pair = usable[kBoxPair] ? x[kBoxPair] : -1;
+    // No box tested one at a time (no bvh-gs among the runs): a box test priced without knowing
+    // the structure costs what the runs' box tests cost.
+    if (!usable[0]) c.costs.box = usable[kBoxPair] ? x[kBoxPair] : usable[kBoxSimd] ? x[kBoxSimd] : 0.0;
     c.costs.cache = x[kCache];
     c.costs.polygon_edge = edge;
     c.costs.cache_bytes = shape.cache_bytes;
@@ -283,6 +289,7 @@ void write_costs(const std::string& path, const Calibration& c, std::span<const 
                         {"hop", c.costs.hop}, {"classify", c.costs.classify}, {"prim", prim},
                         {"per_ray", c.costs.per_ray}, {"step", c.costs.step},
                         {"box_simd", c.costs.box_simd >= 0 ? nlohmann::json(c.costs.box_simd) : nlohmann::json(nullptr)},
+                        {"box_pair", c.costs.box_pair >= 0 ? nlohmann::json(c.costs.box_pair) : nlohmann::json(nullptr)},
                         {"cache", c.costs.cache}, {"cache_bytes", c.costs.cache_bytes},
                         {"polygon_edge", c.costs.polygon_edge},
                         {"rms_relative_residual", c.rms_relative},

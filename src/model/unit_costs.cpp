@@ -18,7 +18,8 @@ double UnitCosts::scalar(const CostVector& c) const {
 
 double UnitCosts::scalar(const CostVector& c, const StructureStats& s) const {
     double v = scalar(c) + cache * c.steps * cache_doublings(s.bytes);
-    if (s.box_lanes > 1 && box_simd >= 0) v += (box_simd - box) * c.box;
+    const double lanes_box = s.box_lanes >= 4 ? box_simd : s.box_lanes == 2 ? box_pair : -1;
+    if (lanes_box >= 0) v += (lanes_box - box) * c.box;
     return v;
 }
 
@@ -114,6 +115,7 @@ UnitCosts UnitCosts::read(const std::string& path) {
     get(j, "per_ray", u.per_ray);
     get(j, "step", u.step);
     if (j.contains("box_simd") && !j["box_simd"].is_null()) get(j, "box_simd", u.box_simd);
+    if (j.contains("box_pair") && !j["box_pair"].is_null()) get(j, "box_pair", u.box_pair);
     get(j, "cache", u.cache);
     get(j, "cache_bytes", u.cache_bytes);
     get(j, "polygon_edge", u.polygon_edge);

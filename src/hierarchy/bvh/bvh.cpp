@@ -25,6 +25,8 @@ StructureStats Bvh::compute_structure() const {
     s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + prims_.size() * sizeof(LeafPrim) +
               packs_.bytes();
     s.limits = d_.limits;
+    // A binary node's two boxes are tested at once (pair_entry); a wider node's one by one.
+    s.box_lanes = std::all_of(d_.nodes.begin(), d_.nodes.end(), [](const Node& n) { return n.leaf || n.count == 2; }) ? 2 : 1;
     return s;
 }
 
