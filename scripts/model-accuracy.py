@@ -175,7 +175,7 @@ def main():
                 "included. The target is 2%. The sample is 2% of the rays where there are at least 12,800 "
                 "(at least 256 rays, at most 4,096); the table counts only the runs whose sample is at most 2% of their rays.\n\n"
                 "Beside it, the same sample's rays traced once through the hierarchy (real primitive tests, "
-                "not counted, right after the prediction replayed them, so finding their nodes in the cache): "
+                "not counted, after the predictions: the segments replay, then the sampled and geometric ones): "
                 "`its rays traced` is that trace over the whole distribution's, `replay / traced` the "
                 "prediction over that trace. Replaying the sample costs about what tracing its rays does; "
                 "its rays cost more per ray than the distribution traced in its order, as a few thousand rays "

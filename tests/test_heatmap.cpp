@@ -106,6 +106,15 @@ TEST(HeatValues, OpsAreUnitCostsOfEveryOperationAndTimeNeedsTiming) {
     EXPECT_DOUBLE_EQ(timed[70], 10.0 + 2.0 * p.box + 0.5 * p.plane + p.hop + p.classify +
                                     3.0 * (p.prim[0] + p.prim[1] + p.prim[2] + p.prim[3]));
     EXPECT_EQ(heat_units(HeatKind::Ops, ns), "ns per pixel (operations x calibrated costs)");
+    // A structure's box tests at its own price: a binary BVH's pairs at box_pair.
+    ns.box_pair = 0.25;
+    PixelCosts paired = pc;
+    paired.box_lanes = 2;
+    EXPECT_DOUBLE_EQ(heat_values(paired, HeatKind::Ops, ns)[70], timed[70] - 1.75 * p.box);
+    EXPECT_DOUBLE_EQ(heat_values(pc, HeatKind::Ops, ns)[70], timed[70]);
+    EXPECT_GT(p.box, 0u);  // the kd-tree's clip to the root box
+    EXPECT_EQ(pc.box_lanes, 1);
+    EXPECT_EQ(pixel_costs(*build_hierarchy(s, "bvh-sah"), opt).box_lanes, 2);
     EXPECT_THROW(heat_values(pc, HeatKind::Time), InputError);
     opt.time = true;
     PixelCosts tpc = pixel_costs(*h, opt);

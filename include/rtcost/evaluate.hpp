@@ -106,7 +106,7 @@ struct EvalRow {
     int threads = 1;
     std::vector<double> measured_visits;  ///< measured traversal steps per depth per ray
     /// Seconds one single-thread trace of the segments sample's rays takes (each kind with its
-    /// query; not counted), right after the segments prediction replayed them; 0 without one.
+    /// query; not counted), after the predictions (the segments replay among them); 0 without one.
     double sample_trace_seconds = 0;
     /// 1 = cheapest, 0 = not ranked: by predicted cost (ns when the costs are calibrated), by
     /// counted operations (in unit costs), and by measured time.

@@ -65,6 +65,7 @@ struct PixelCosts {
     RayCounters total;  ///< every ray's counters summed (equals trace_rays over the same rays)
     bool timed = false;
     std::vector<CostVector> predicted;  ///< per pixel, when PixelCostOptions::predict was set
+    int box_lanes = 1;  ///< the hierarchy's StructureStats::box_lanes (what its box tests cost)
 };
 
 /// Traces each pixel's rays through `h` with counting (and, when asked, again timed), and sums

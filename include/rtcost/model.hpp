@@ -62,9 +62,12 @@ struct UnitCosts {
     /// Operations, steps and the fixed cost (no structure known: box tests priced at `box`, no
     /// cache term).
     double scalar(const CostVector& c) const;
-    /// The time model of a structure: as scalar(c), with its box tests priced at `box_simd` when
-    /// they are SIMD and the cache term for its size.
+    /// The time model of a structure: as scalar(c), with its box tests priced as box_price of its
+    /// lanes and the cache term for its size.
     double scalar(const CostVector& c, const StructureStats& s) const;
+    /// A box test of a structure that tests `box_lanes` boxes at once (StructureStats::box_lanes):
+    /// `box_simd` for 4 or more, `box_pair` for 2, where known; `box` otherwise.
+    double box_price(int box_lanes) const;
     /// The cache term's factor: log2(bytes / cache_bytes), 0 for a structure that fits.
     double cache_doublings(std::uint64_t bytes) const;
     /// Reads a costs file (JSON `{"unit": "ns", "box": ns, "plane": ns, ..., "per_ray": ns,

@@ -40,7 +40,8 @@ public:
     }
 
     /// The same with the time model's terms of the structure: the cache misses of its size and
-    /// its SIMD box tests (a costs file's cache and box_simd; built-in typical costs have both).
+    /// its box tests made several at once (a costs file's cache, box_simd and box_pair; built-in
+    /// typical costs have the first two).
     /// What a design compares built candidates by.
     template <class H>
     double time(const H& h) const {

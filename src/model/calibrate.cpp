@@ -257,8 +257,9 @@ Calibration calibrate(std::span<const CalibrationSample> samples, const TimeTerm
     c.costs.step = x[kStep];
     c.costs.box_simd = usable[kBoxSimd] ? x[kBoxSimd] : -1;
     c.costs.box_pair = usable[kBoxPair] ? x[kBoxPair] : -1;
-    // No box tested one at a time (no bvh-gs among the runs): a box test priced without knowing
-    // the structure costs what the runs' box tests cost.
+    // No run tests a box on its own (bvh-gs's nodes do, and the cell structures' and rc5d's clip
+    // of each ray to the root box): a box test priced without knowing the structure costs what
+    // the runs' box tests cost.
     if (!usable[0]) c.costs.box = usable[kBoxPair] ? x[kBoxPair] : usable[kBoxSimd] ? x[kBoxSimd] : 0.0;
     c.costs.cache = x[kCache];
     c.costs.polygon_edge = edge;

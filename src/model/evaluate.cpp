@@ -287,12 +287,12 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                     if (est == Estimator::Geometric && seen) row.predictions.back().seconds += grow_seconds;
                 }
             }
-            // The segments sample's own rays traced once (real tests, not counted), right after its
-            // prediction replayed them: what its rays cost a trace, against what replaying them
-            // cost (a few thousand rays spread over the whole distribution, far less coherent
-            // than the distribution traced in its order).
+            // The segments sample's own rays traced once (real tests, not counted), after the
+            // predictions (the segments replay among them): what its rays cost a trace, against
+            // what replaying them cost (a few thousand rays spread over the whole distribution,
+            // far less coherent than the distribution traced in its order).
             if (segments) {
-                const auto start = std::chrono::steady_clock::now();
+                double traced = 0;
                 for (int k = 0; k < kRayKinds; ++k) {
                     if (test_kinds[k].empty() || sample_kinds[k].empty()) continue;
                     std::vector<Ray> rays;
@@ -300,14 +300,14 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
                     TraceOptions t;
                     t.query = query_of(k);
                     t.threads = 1;
-                    trace_rays(*h, rays, t);
+                    traced += trace_rays(*h, rays, t).seconds;
                 }
-                row.sample_trace_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+                row.sample_trace_seconds = traced;
             }
         }
         row.measured = measured_cost(counted.counters);
-        // The time model prices what the structure is as well as what it does (its SIMD box
-        // tests, its size against the cache); with unit costs this is the operation count.
+        // The time model prices what the structure is as well as what it does (its box tests made
+        // several at once, its size against the cache); with unit costs this is the operation count.
         row.measured_scalar = costs.scalar(row.measured, row.structure);
         for (Prediction& p : row.predictions) p.scalar = costs.scalar(p.cost, row.structure);
         const Prediction* head = row.headline();

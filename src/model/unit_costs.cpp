@@ -18,9 +18,13 @@ double UnitCosts::scalar(const CostVector& c) const {
 
 double UnitCosts::scalar(const CostVector& c, const StructureStats& s) const {
     double v = scalar(c) + cache * c.steps * cache_doublings(s.bytes);
-    const double lanes_box = s.box_lanes >= 4 ? box_simd : s.box_lanes == 2 ? box_pair : -1;
-    if (lanes_box >= 0) v += (lanes_box - box) * c.box;
+    v += (box_price(s.box_lanes) - box) * c.box;
     return v;
+}
+
+double UnitCosts::box_price(int box_lanes) const {
+    const double lanes = box_lanes >= 4 ? box_simd : box_lanes == 2 ? box_pair : -1;
+    return lanes >= 0 ? lanes : box;
 }
 
 double UnitCosts::cache_doublings(std::uint64_t bytes) const {

@@ -58,6 +58,7 @@ PixelCosts pixel_costs(const Hierarchy& h, const PixelCostOptions& opt) {
     pc.width = opt.width;
     pc.height = opt.height;
     pc.timed = opt.time;
+    pc.box_lanes = h.structure().box_lanes;
     pc.pixels.resize(eye.size());
     if (opt.predict) pc.predicted.resize(eye.size());
     std::vector<RayCounters> rows(static_cast<std::size_t>(opt.height));
@@ -123,6 +124,7 @@ std::vector<double> heat_values(const PixelCosts& pc, HeatKind kind, const UnitC
     if (kind == HeatKind::Predicted && pc.predicted.size() != pc.pixels.size())
         throw InputError("--heatmap", 0, "predicted: the pixels were not predicted");
     std::vector<double> out(pc.pixels.size());
+    const double box = costs.box_price(pc.box_lanes);
     for (std::size_t i = 0; i < out.size(); ++i) {
         const PixelCost& p = pc.pixels[i];
         const double prims = static_cast<double>(p.prim[0]) + p.prim[1] + p.prim[2] + p.prim[3];
@@ -136,16 +138,16 @@ std::vector<double> heat_values(const PixelCosts& pc, HeatKind kind, const UnitC
             case HeatKind::Time: out[i] = p.ns; break;
             case HeatKind::Predicted: {
                 const CostVector& c = pc.predicted[i];
-                double s = costs.per_ray * p.rays + costs.box * c.box + costs.plane * c.plane + costs.hop * c.hop +
+                double s = costs.per_ray * p.rays + box * c.box + costs.plane * c.plane + costs.hop * c.hop +
                            costs.classify * c.classify + costs.step * c.steps + costs.polygon_edge * c.polygon_edges;
                 for (int k = 0; k < kPrimKinds; ++k) s += costs.prim[k] * c.prim[k];
                 out[i] = s;
                 break;
             }
             case HeatKind::Ops: {
-                // UnitCosts::scalar of the summed operations plus the fixed cost of every ray (the
-                // structure's terms, SIMD boxes and cache, aside: one structure per map).
-                double s = costs.per_ray * p.rays + costs.box * p.box + costs.plane * p.plane + costs.hop * p.hop +
+                // UnitCosts::scalar of the summed operations plus the fixed cost of every ray, its
+                // box tests at the structure's price (the cache term aside: one structure per map).
+                double s = costs.per_ray * p.rays + box * p.box + costs.plane * p.plane + costs.hop * p.hop +
                            costs.classify * p.classify + costs.step * p.steps + costs.polygon_edge * p.polygon_edges;
                 for (int k = 0; k < kPrimKinds; ++k) s += costs.prim[k] * p.prim[k];
                 out[i] = s;
