@@ -367,6 +367,10 @@ TEST(UnitCosts, ReadsACostsFileAndRejectsBadOnes) {
     EXPECT_THROW(UnitCosts::read(bad.string()), InputError);
     std::ofstream(bad) << "{not json";
     EXPECT_THROW(UnitCosts::read(bad.string()), InputError);
+    std::ofstream(bad) << R"({"box": 2, "box_pair": 1e999})";  // beyond a double: the parser's own error
+    EXPECT_THROW(UnitCosts::read(bad.string()), InputError);
+    std::ofstream(bad) << R"({"box": 2, "box_pair": -1})";
+    EXPECT_THROW(UnitCosts::read(bad.string()), InputError);
 }
 
 }  // namespace

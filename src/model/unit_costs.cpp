@@ -102,7 +102,7 @@ UnitCosts UnitCosts::read(const std::string& path) {
     nlohmann::json j;
     try {
         j = nlohmann::json::parse(in);
-    } catch (const nlohmann::json::parse_error& e) {
+    } catch (const nlohmann::json::exception& e) {  // malformed, or a number beyond a double (1e999)
         throw InputError(path, 0, std::string("not a costs file: ") + e.what());
     }
     UnitCosts u;
