@@ -4,6 +4,7 @@
 #include <map>
 #include <numbers>
 #include <optional>
+#include <random>
 
 #include "rtcost/model.hpp"
 #include "test_support.hpp"
@@ -168,6 +169,48 @@ TEST(BvhStructure, BinaryTreesHaveOneMoreLeafThanInteriorNodes) {
     EXPECT_EQ(m->structure().interior, s.size() - 1);
     // Median cut halves the list: depth is ceil(log2 N).
     EXPECT_EQ(m->structure().depth, 8);  // 256 triangles
+}
+
+// bvh-sah's max_prims=auto and c_trav=auto: leaves of up to 16 triangles, a step priced as four
+// tests, on a mesh of 2^16 triangles or more (tested four at a time); 8 and 1 otherwise.
+TEST(BvhStructure, SahLeafCostsFollowTheMeshSize) {
+    auto same_tree = [](const Hierarchy& a, const Hierarchy& b) {
+        const StructureStats x = a.structure(), y = b.structure();
+        return x.leaves == y.leaves && x.interior == y.interior && x.depth == y.depth && x.bytes == y.bytes;
+    };
+    // Small triangles scattered through a cube: 2^16 of them.
+    auto scattered = [](std::uint32_t n) {
+        Scene s;
+        std::mt19937 rng(3);
+        std::uniform_real_distribution<float> u(0.0f, 1.0f);
+        for (std::uint32_t i = 0; i < n; ++i) {
+            const Vec3 c{u(rng), u(rng), u(rng)};
+            s.add(Triangle{c, c + Vec3{0.01f * u(rng), 0.01f, 0}, c + Vec3{0, 0.01f * u(rng), 0.01f}}, 0);
+        }
+        s.finalize();
+        return s;
+    };
+    Scene large = scattered(65536);
+    auto automatic = build_hierarchy(large, "bvh-sah");
+    auto big = build_hierarchy(large, "bvh-sah", {"max_prims=16", "c_trav=4"});
+    auto usual = build_hierarchy(large, "bvh-sah", {"max_prims=8", "c_trav=1"});
+    EXPECT_TRUE(same_tree(*automatic, *big));
+    EXPECT_LT(automatic->structure().leaves, usual->structure().leaves * 3 / 4);
+    // Same closest hits as brute force with the larger leaves.
+    const std::vector<Ray> rays = random_rays(large.bounds(), 500, 5);
+    std::string first;
+    EXPECT_EQ(count_mismatches(closest_hits(*build_hierarchy(large, "brute"), rays), closest_hits(*automatic, rays),
+                               0.0f, &first),
+              0u)
+        << first;
+    // One primitive short of the bound, or one that is not a triangle: bvh-sah's usual costs.
+    Scene smaller = scattered(65535);
+    EXPECT_TRUE(same_tree(*build_hierarchy(smaller, "bvh-sah"),
+                          *build_hierarchy(smaller, "bvh-sah", {"max_prims=8", "c_trav=1"})));
+    large.add(Sphere{{0, 0, 0}, 0.01f}, 0);
+    large.finalize();
+    EXPECT_TRUE(same_tree(*build_hierarchy(large, "bvh-sah"),
+                          *build_hierarchy(large, "bvh-sah", {"max_prims=8", "c_trav=1"})));
 }
 
 TEST(BvhStructure, MaxDepthZeroIsOneLeaf) {

@@ -277,11 +277,11 @@ const Registration reg{
          BvhData designed_tree = build_design(s, in, o, info, root);
          // bvh-sah's tree where the model predicts it cheaper on the sample than the designed
          // splits (as design/cheaper.hpp does for the other families).
-         SahOptions usual;
+         SahOptions usual = sah_leaf_costs(s);
          usual.max_depth = o.max_depth;
          usual.bins = o.bins;
          // With bvh-sah's defaults that tree is the sample's reference, already built.
-         const SahOptions sah_defaults;
+         const SahOptions sah_defaults = sah_leaf_costs(s);
          const auto* reference = dynamic_cast<const Bvh*>(in.reference.get());
          const bool as_reference = reference && usual.max_depth == sah_defaults.max_depth && usual.bins == sah_defaults.bins;
          auto by_sah = std::make_unique<Bvh>(s, "bvh-design", as_reference ? reference->data() : build_sah(s, usual), true);

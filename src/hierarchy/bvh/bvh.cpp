@@ -131,20 +131,26 @@ const Registration gs_reg{
 const Registration sah_reg{
     {"bvh-sah",
      "binned SAH BVH (Wald 2007); sweep=1 for the full sweep",
-     {ParamSpec::integer("max_prims", "8", 1, kMaxLeaf, "largest leaf (bigger nodes are always split)"),
+     {ParamSpec::integer("max_prims", "auto", 1, kMaxLeaf,
+                         "largest leaf (bigger nodes are always split); auto: 16 on a mesh of at least 65,536 "
+                         "triangles (tested four at a time), else 8",
+                         {"auto"}),
       ParamSpec::integer("max_depth", "64", 0, kMaxDepth, "deepest leaf"),
       ParamSpec::integer("bins", "16", 2, 256, "bins per axis for the binned build"),
       ParamSpec::flag("sweep", "0", "1: evaluate every split of the sorted centroids (full sweep SAH)"),
-      ParamSpec::real("c_trav", "1", 0, 1e6, "SAH cost of a traversal step"),
+      ParamSpec::real("c_trav", "auto", 0, 1e6,
+                      "SAH cost of a traversal step; auto: 4 on a mesh of at least 65,536 triangles (its "
+                      "tree outgrows the cache), else 1",
+                      {"auto"}),
       ParamSpec::real("c_isect", "1", 1e-6, 1e6, "SAH cost of a primitive test"),
       kOrder, kAnyOrder},
      [](const Scene& s, const Params& p) {
-         SahOptions o;
-         o.max_prims = static_cast<int>(p.integer("max_prims"));
+         SahOptions o = sah_leaf_costs(s);
+         if (!p.is("max_prims", "auto")) o.max_prims = static_cast<int>(p.integer("max_prims"));
          o.max_depth = static_cast<int>(p.integer("max_depth"));
          o.bins = static_cast<int>(p.integer("bins"));
          o.sweep = p.flag("sweep");
-         o.c_trav = static_cast<float>(p.real("c_trav"));
+         if (!p.is("c_trav", "auto")) o.c_trav = static_cast<float>(p.real("c_trav"));
          o.c_isect = static_cast<float>(p.real("c_isect"));
          return ordered(s, "bvh-sah", build_sah(s, o), p);
      }},

@@ -60,6 +60,14 @@ struct SahOptions {
 };
 BvhData build_sah(const Scene& s, const SahOptions& o);
 
+/// bvh-sah's leaf costs for scene `s` (its `max_prims=auto` and `c_trav=auto`): larger leaves
+/// (16, a step priced as 4 tests) for a mesh of at least 2^16 triangles, whose leaves are tested
+/// four at a time (leaf_packs.hpp) and whose tree outgrows the cache, so that a step waits on
+/// memory; SahOptions' defaults (8 and 1) otherwise. Measured against 8 and 1 on 256x256 rays,
+/// one core: rings-mesh spd 21% and yxa_1 spd 18% faster, balls-mesh 5-10%, 2CylinderEngine 3%;
+/// on teapot (9,264 triangles, a 0.7 MiB tree) the same change was 11-15% slower.
+SahOptions sah_leaf_costs(const Scene& s, SahOptions o = {});
+
 /// The BVH hierarchy over built data. `ordered`: near child first and children whose entry lies
 /// beyond the current hit skipped; otherwise every child whose box the ray meets is visited, in
 /// stored order, and no subtree is cut by a hit found (the paper's BVH case).

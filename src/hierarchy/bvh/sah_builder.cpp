@@ -206,4 +206,18 @@ BvhData build_sah(const Scene& s, const SahOptions& o) {
     });
 }
 
+SahOptions sah_leaf_costs(const Scene& s, SahOptions o) {
+    // Where every primitive is tested as a triangle (a triangle, or a polygon of three vertices:
+    // leaf_prims.hpp), the binary BVHs test their leaves a pack of four at a time.
+    constexpr std::size_t kLargeMesh = std::size_t{1} << 16;
+    if (s.size() < kLargeMesh) return o;
+    for (std::uint32_t i = 0; i < s.size(); ++i) {
+        const PrimKind k = s.kind(i);
+        if (k != PrimKind::Triangle && !(k == PrimKind::Polygon && s.polygons[s.prims[i].index].count == 3)) return o;
+    }
+    o.max_prims = 16;
+    o.c_trav = 4;
+    return o;
+}
+
 }  // namespace rtcost::bvh
