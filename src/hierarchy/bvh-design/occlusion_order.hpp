@@ -160,7 +160,7 @@ private:
     /// next step waited for, the walk took 8-10% longer per ray on the same operations, and its
     /// gain over bvh-sah's walk on shadow rays was 1-14 points smaller: lattice 13.8% against 28.3%,
     /// rings 21.1% against 27.4%.)
-    std::vector<Node> nodes_;
+    NodeArray nodes_;
 };
 
 }  // namespace rtcost::bvh
