@@ -92,6 +92,8 @@ BvhData build_sah(const Scene& s, const SahOptions& o);
 /// one core: rings-mesh spd 21% and yxa_1 spd 18% faster, balls-mesh 5-10%, 2CylinderEngine 3%;
 /// on teapot (9,264 triangles, a 0.7 MiB tree) the same change was 11-15% slower.
 SahOptions sah_leaf_costs(const Scene& s, SahOptions o = {});
+/// Whether `s` is such a mesh: at least 2^16 primitives, each tested as a triangle.
+bool large_triangle_mesh(const Scene& s);
 
 /// The BVH hierarchy over built data. `ordered`: near child first and children whose entry lies
 /// beyond the current hit skipped; otherwise every child whose box the ray meets is visited, in

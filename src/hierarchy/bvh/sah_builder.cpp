@@ -206,15 +206,20 @@ BvhData build_sah(const Scene& s, const SahOptions& o) {
     });
 }
 
-SahOptions sah_leaf_costs(const Scene& s, SahOptions o) {
-    // Where every primitive is tested as a triangle (a triangle, or a polygon of three vertices:
-    // leaf_prims.hpp), the binary BVHs test their leaves a pack of four at a time.
+bool large_triangle_mesh(const Scene& s) {
+    // Every primitive tested as a triangle (a triangle, or a polygon of three vertices:
+    // leaf_prims.hpp): the binary BVHs then test their leaves a pack of four at a time.
     constexpr std::size_t kLargeMesh = std::size_t{1} << 16;
-    if (s.size() < kLargeMesh) return o;
+    if (s.size() < kLargeMesh) return false;
     for (std::uint32_t i = 0; i < s.size(); ++i) {
         const PrimKind k = s.kind(i);
-        if (k != PrimKind::Triangle && !(k == PrimKind::Polygon && s.polygons[s.prims[i].index].count == 3)) return o;
+        if (k != PrimKind::Triangle && !(k == PrimKind::Polygon && s.polygons[s.prims[i].index].count == 3)) return false;
     }
+    return true;
+}
+
+SahOptions sah_leaf_costs(const Scene& s, SahOptions o) {
+    if (!large_triangle_mesh(s)) return o;
     o.max_prims = 16;
     o.c_trav = 4;
     return o;
