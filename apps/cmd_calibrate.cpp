@@ -109,7 +109,6 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         fit["step"] = terms.steps ? json(c.costs.step) : json(nullptr);
         fit["box_simd"] = c.costs.box_simd >= 0 ? json(c.costs.box_simd) : json(nullptr);
         fit["box_pair"] = c.costs.box_pair >= 0 ? json(c.costs.box_pair) : json(nullptr);
-        fit["tri_pack"] = c.costs.tri_pack >= 0 ? json(c.costs.tri_pack) : json(nullptr);
         fit["cache"] = terms.cache ? json(c.costs.cache) : json(nullptr);
         fit["cache_bytes"] = c.costs.cache_bytes;
         fit["polygon_edge"] = terms.edges ? json(c.costs.polygon_edge) : json(nullptr);
@@ -153,11 +152,6 @@ int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
         fmt::print("  {:<10} {}\n", "box pair",
                    c.costs.box_pair >= 0 ? fmt::format("{:.3f} (per box test of a binary node's pair)", c.costs.box_pair)
                                          : "(no binary BVH measured: priced as box)");
-    if (terms.simd)
-        fmt::print("  {:<10} {}\n", "tri pack",
-                   c.costs.tri_pack >= 0
-                       ? fmt::format("{:.3f} (per triangle test of a pack of triangles tested at once)", c.costs.tri_pack)
-                       : "(no structure testing triangles in packs measured: priced by kind)");
     if (terms.cache)
         fmt::print("  {:<10} {:.3f} (per step, per doubling of the structure beyond {})\n", "cache", c.costs.cache,
                    human_bytes(static_cast<std::uint64_t>(c.costs.cache_bytes)));

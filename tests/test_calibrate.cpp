@@ -64,14 +64,12 @@ TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
     truth.box = 3; truth.plane = 5; truth.hop = 0; truth.classify = 0; truth.per_ray = 20;
     truth.prim = {12, 30, 0, 0};
     truth.step = 6; truth.box_simd = 0.5; truth.box_pair = 1.5; truth.cache = 2; truth.cache_bytes = 1 << 20;
-    truth.tri_pack = 4;
     std::vector<CalibrationSample> runs = timed_runs(truth, 16, [&](int i, CalibrationSample& s) {
         s.ops.box = 4 + 5 * (i % 7);
         s.ops.plane = (i % 3) * 6.0;
         s.ops.steps = 3 + (i * 5) % 11;
         s.ops.prim = {1.0 + i % 4, (i % 2) * 3.0, 0, 0};
         s.structure.box_lanes = i % 4 == 3 ? 8 : i % 4 == 1 ? 2 : 1;
-        s.structure.prim_lanes = i % 5 == 2 ? 4 : 1;  // every primitive test a lane of a pack
         s.structure.bytes = std::uint64_t(1) << (16 + i % 9);  // 64 KiB .. 16 MiB
     });
     Calibration c = calibrate(runs, {}, 1 << 20);
@@ -80,8 +78,6 @@ TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
     EXPECT_NEAR(c.costs.step, 6, 1e-6);
     EXPECT_NEAR(c.costs.box_simd, 0.5, 1e-6);
     EXPECT_NEAR(c.costs.box_pair, 1.5, 1e-6);
-    EXPECT_NEAR(c.costs.tri_pack, 4, 1e-6);
-    EXPECT_NEAR(c.costs.prim[0], 12, 1e-6);  // the packs' tests apart
     EXPECT_NEAR(c.costs.cache, 2, 1e-6);
     EXPECT_NEAR(c.costs.per_ray, 20, 1e-5);
     EXPECT_NEAR(c.rms_relative, 0, 1e-9);
@@ -91,8 +87,7 @@ TEST(Calibrate, FitsTheTimeModelsStepSimdAndCacheTerms) {
     EXPECT_EQ(ops.costs.step, 0);
     EXPECT_LT(ops.costs.box_simd, 0);  // not fitted: priced as box
     EXPECT_LT(ops.costs.box_pair, 0);
-    EXPECT_LT(ops.costs.tri_pack, 0);
-    EXPECT_FALSE(ops.fitted[ops.fitted.size() - 6]);  // step
+    EXPECT_FALSE(ops.fitted[ops.fitted.size() - 5]);  // step
     EXPECT_FALSE(ops.fitted.back());                  // polygon_edge
     // Every box test in pairs (binary BVHs alone): box_pair is fitted, and a box test priced
     // without its structure costs the same, not the 0 of an unexercised kind.

@@ -332,12 +332,6 @@ TEST(UnitCosts, TheTimeModelPricesSimdBoxTestsAndTheCacheByTheStructure) {
     u.box_pair = 1;
     EXPECT_DOUBLE_EQ(u.scalar(c, binary), 10 + 12 + 20);
     EXPECT_DOUBLE_EQ(u.scalar(c, wide), 5 + 12 + 20 + 8);
-    // Triangles tested a pack at a time at tri_pack once it is known; at their kind's price before.
-    binary.prim_lanes = 4;
-    EXPECT_DOUBLE_EQ(u.scalar(c, binary), 10 + 12 + 20);
-    u.tri_pack = 2.5;
-    EXPECT_DOUBLE_EQ(u.scalar(c, binary), 10 + 12 + 5);
-    EXPECT_DOUBLE_EQ(u.scalar(c, small), 20 + 12 + 20);
     EXPECT_DOUBLE_EQ(u.cache_doublings(16u << 20), 0);
     EXPECT_DOUBLE_EQ(u.cache_doublings(32u << 20), 1);
 }

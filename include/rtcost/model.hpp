@@ -50,10 +50,6 @@ struct UnitCosts {
     /// Per box test of a structure that tests two boxes at once (box_lanes 2: the binary BVHs);
     /// negative: as `box`.
     double box_pair = -1;
-    /// Per primitive test of a structure whose every primitive test is a lane of a pack of
-    /// triangles (StructureStats::prim_lanes of 4 or more: bvh-wide, a binary BVH over a mesh),
-    /// instead of the kind's price; negative: at the kind's price.
-    double tri_pack = -1;
     /// Per traversal step, for each doubling of the structure's bytes beyond `cache_bytes`: the
     /// memory a step waits on once the structure no longer fits in the cache.
     double cache = 0;
@@ -72,12 +68,10 @@ struct UnitCosts {
     /// A box test of a structure that tests `box_lanes` boxes at once (StructureStats::box_lanes):
     /// `box_simd` for 4 or more, `box_pair` for 2, where known; `box` otherwise.
     double box_price(int box_lanes) const;
-    /// The primitive tests of `c` at each kind's price.
-    double scalar_prims(const CostVector& c) const;
     /// The cache term's factor: log2(bytes / cache_bytes), 0 for a structure that fits.
     double cache_doublings(std::uint64_t bytes) const;
     /// Reads a costs file (JSON `{"unit": "ns", "box": ns, "plane": ns, ..., "per_ray": ns,
-    /// "step": ns, "box_simd": ns, "box_pair": ns, "tri_pack": ns, "cache": ns, "cache_bytes": bytes,
+    /// "step": ns, "box_simd": ns, "box_pair": ns, "cache": ns, "cache_bytes": bytes,
     /// "polygon_edge": ns, "prim": {"triangle": ns, ...}}`; the time model's terms are optional:
     /// `box_simd` and `box_pair` then price those box tests as `box`, `step`, `cache` and
     /// `polygon_edge` are 0).

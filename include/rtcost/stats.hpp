@@ -100,10 +100,6 @@ struct StructureStats {
     /// BVH's two children in one test); 1: one at a time (bvh-gs's n-ary nodes). Counted box
     /// tests are the same either way; the time model prices them apart.
     int box_lanes = 1;
-    /// Triangles one primitive test handles at once where every primitive test of the structure
-    /// is a lane of a pack (bvh-wide: 4 or 8; a binary BVH over triangles: 4); 1 otherwise.
-    /// Counted primitive tests are the same either way; the time model prices them apart.
-    int prim_lanes = 1;
     double seconds = 0;             ///< build time
     /// Bounds on time or memory that stopped the build short of what its parameters asked
     /// ("grid: resolution 46x46x46 reduced to ..."); empty when none did.

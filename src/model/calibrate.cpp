@@ -17,11 +17,11 @@
 namespace rtcost {
 namespace {
 
-// box, plane, hop, classify, prims, per_ray, then the time model's step, box_simd, cache, box_pair,
-// tri_pack and polygon_edge (timed, not fitted: polygon_edge_ns).
+// box, plane, hop, classify, prims, per_ray, then the time model's step, box_simd, cache, box_pair
+// and polygon_edge (timed, not fitted: polygon_edge_ns).
 constexpr int kOps = 4 + kPrimKinds + 1;
-constexpr int kStep = kOps, kBoxSimd = kOps + 1, kCache = kOps + 2, kBoxPair = kOps + 3, kTriPack = kOps + 4,
-              kEdge = kOps + 5, kUnknowns = kOps + 6;
+constexpr int kStep = kOps, kBoxSimd = kOps + 1, kCache = kOps + 2, kBoxPair = kOps + 3, kEdge = kOps + 4,
+              kUnknowns = kOps + 5;
 
 }  // namespace
 
@@ -90,10 +90,7 @@ std::array<double, kUnknowns> row_of(const CalibrationSample& s, const TimeTerms
     r[1] = c.plane;
     r[2] = c.hop;
     r[3] = c.classify;
-    // Primitive tests made a pack of triangles at a time (bvh-wide, a binary BVH over a mesh).
-    if (terms.simd && s.structure.prim_lanes >= 4) r[kTriPack] = c.prim_tests();
-    else
-        for (int k = 0; k < kPrimKinds; ++k) r[4 + k] = c.prim[k];
+    for (int k = 0; k < kPrimKinds; ++k) r[4 + k] = c.prim[k];
     r[kOps - 1] = 1;
     if (terms.steps) r[kStep] = c.steps;
     if (terms.cache) r[kCache] = c.steps * shape.cache_doublings(s.structure.bytes);
@@ -260,7 +257,6 @@ Calibration calibrate(std::span<const CalibrationSample> samples, const TimeTerm
     c.costs.step = x[kStep];
     c.costs.box_simd = usable[kBoxSimd] ? x[kBoxSimd] : -1;
     c.costs.box_pair = usable[kBoxPair] ? x[kBoxPair] : -1;
-    c.costs.tri_pack = usable[kTriPack] ? x[kTriPack] : -1;
     // No run tests a box on its own (bvh-gs's nodes do, and the cell structures' and rc5d's clip
     // of each ray to the root box): a box test priced without knowing the structure costs what
     // the runs' box tests cost.
@@ -295,7 +291,6 @@ void write_costs(const std::string& path, const Calibration& c, std::span<const 
                         {"per_ray", c.costs.per_ray}, {"step", c.costs.step},
                         {"box_simd", c.costs.box_simd >= 0 ? nlohmann::json(c.costs.box_simd) : nlohmann::json(nullptr)},
                         {"box_pair", c.costs.box_pair >= 0 ? nlohmann::json(c.costs.box_pair) : nlohmann::json(nullptr)},
-                        {"tri_pack", c.costs.tri_pack >= 0 ? nlohmann::json(c.costs.tri_pack) : nlohmann::json(nullptr)},
                         {"cache", c.costs.cache}, {"cache_bytes", c.costs.cache_bytes},
                         {"polygon_edge", c.costs.polygon_edge},
                         {"rms_relative_residual", c.rms_relative},

@@ -19,14 +19,7 @@ double UnitCosts::scalar(const CostVector& c) const {
 double UnitCosts::scalar(const CostVector& c, const StructureStats& s) const {
     double v = scalar(c) + cache * c.steps * cache_doublings(s.bytes);
     v += (box_price(s.box_lanes) - box) * c.box;
-    if (s.prim_lanes >= 4 && tri_pack >= 0) v += tri_pack * c.prim_tests() - scalar_prims(c);
     return v;
-}
-
-double UnitCosts::scalar_prims(const CostVector& c) const {
-    double s = 0;
-    for (int k = 0; k < kPrimKinds; ++k) s += prim[k] * c.prim[k];
-    return s;
 }
 
 double UnitCosts::box_price(int box_lanes) const {
@@ -127,7 +120,6 @@ UnitCosts UnitCosts::read(const std::string& path) {
     get(j, "step", u.step);
     if (j.contains("box_simd") && !j["box_simd"].is_null()) get(j, "box_simd", u.box_simd);
     if (j.contains("box_pair") && !j["box_pair"].is_null()) get(j, "box_pair", u.box_pair);
-    if (j.contains("tri_pack") && !j["tri_pack"].is_null()) get(j, "tri_pack", u.tri_pack);
     get(j, "cache", u.cache);
     get(j, "cache_bytes", u.cache_bytes);
     get(j, "polygon_edge", u.polygon_edge);

@@ -242,14 +242,12 @@ BvhWide::~BvhWide() = default;
 
 StructureStats BvhWide::compute_structure() const {
     StructureStats s;
-    bool packed_only = true;  // every primitive test a lane of a triangle pack
     with_nodes(*d_, [&](const auto& nodes) {
         s.interior = nodes.size();
         walk_lanes(
             nodes,
             [&](const Box3&, std::uint32_t, std::uint32_t packed, int depth) {
                 const std::uint32_t n = (packed & 0xffffu) + (packed >> 16);
-                packed_only = packed_only && (packed >> 16) == 0;
                 ++s.leaves;
                 s.empty_leaves += n == 0;
                 s.references += n;
@@ -260,7 +258,6 @@ StructureStats BvhWide::compute_structure() const {
     });
     s.bytes += d_->leaves.size() * sizeof(Data::Block);
     s.box_lanes = view_.width;  // one slab test for all of a node's children
-    s.prim_lanes = packed_only && s.references > 0 ? d_->tri_lanes : 1;
     return s;
 }
 

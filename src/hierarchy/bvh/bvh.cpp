@@ -26,7 +26,6 @@ StructureStats Bvh::compute_structure() const {
               packs_.bytes();
     s.limits = d_.limits;
     // A binary node's two boxes are tested at once (pair_entry); a wider node's one by one.
-    s.prim_lanes = packs_.active() ? 4 : 1;  // every reference a lane of a pack (leaf_packs.hpp)
     s.box_lanes = std::all_of(d_.nodes.begin(), d_.nodes.end(), [](const Node& n) { return n.leaf || n.count == 2; }) ? 2 : 1;
     return s;
 }
