@@ -184,7 +184,16 @@ def main():
                 "large, its grid testing 125 triangles per ray at 16 ns each, a cell's triangles adjacent in "
                 "the file) was then predicted 36% off instead of 28%; fitted with yxa_1 it came out at 0.4 ns, "
                 "and 2CylinderEngine's rho moved from 0.900 to 0.918. Where the scene's primitives lie in "
-                "memory matters, not only how large it is.\n\n")
+                "memory matters, not only how large it is.\n\n"
+                "Tried and not kept (2026-12-07): a price per triangle test of the structures whose every "
+                "primitive test is a lane of a pack of four or eight (bvh-wide; the binary BVHs over "
+                "triangles), apart from the kinds' prices, after bvh-sah on 2CylinderEngine was predicted 30% "
+                "over its time with leaves of up to 16 triangles. With the packs' tests out of the kinds' "
+                "columns, the first half fixes the triangle price from 2CylinderEngine's subdivisions alone, "
+                "whose triangles are read where they lie in the file (26.5 ns, against 12.7 ns in the second "
+                "fold; a pack's triangle 9.5 and 5.5 ns): 19.1% mean absolute error held out, 9 of 12 scenes "
+                "at rho 0.95 or more (sombrero 0.850, gears 0.936, 2CylinderEngine 0.946), against the 15.1% "
+                "and 11 of 12 below.\n\n")
         f.write("## Summary\n\n| model | mean absolute error | rho, worst scene | rho, median | scenes at rho >= 0.95 |\n"
                 "|---|---|---|---|---|\n")
         for label, _ in MODELS:
