@@ -91,3 +91,29 @@ TEST(BvhPairEntry, EntersEveryPairOfBoxesWhereBoxEntryDoesAtTheSameDistance) {
 
 }  // namespace
 }  // namespace rtcost::test
+
+namespace rtcost::test {
+namespace {
+
+// Every binary node's two children lie in one 64-byte cache line (bvh.hpp's NodeArray): the
+// walk reads both boxes and prefetches a child's pair as one line.
+TEST(BvhPairEntry, SiblingPairsShareOneCacheLine) {
+    const Scene s = builtin_scene("tetra", 5);
+    for (const char* name : {"bvh-sah", "bvh-median"}) {
+        auto h = build_hierarchy(s, name);
+        const auto* bvh = dynamic_cast<const bvh::Bvh*>(h.get());
+        ASSERT_NE(bvh, nullptr) << name;
+        const bvh::NodeArray& nodes = bvh->data().nodes;
+        std::size_t pairs = 0;
+        for (const bvh::Node& n : nodes) {
+            if (n.leaf || n.count != 2) continue;
+            const auto first = reinterpret_cast<std::uintptr_t>(&nodes[n.index]);
+            EXPECT_EQ(first % 64, 0u) << name << ": children at " << n.index;
+            ++pairs;
+        }
+        EXPECT_GT(pairs, 100u) << name;
+    }
+}
+
+}  // namespace
+}  // namespace rtcost::test

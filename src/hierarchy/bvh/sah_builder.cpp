@@ -207,14 +207,12 @@ BvhData build_sah(const Scene& s, const SahOptions& o) {
 }
 
 bool large_triangle_mesh(const Scene& s) {
-    // Every primitive tested as a triangle (a triangle, or a polygon of three vertices:
-    // leaf_prims.hpp): the binary BVHs then test their leaves a pack of four at a time.
+    // Every primitive tested as a triangle: the binary BVHs then test their leaves a pack of
+    // four at a time (leaf_packs.hpp).
     constexpr std::size_t kLargeMesh = std::size_t{1} << 16;
     if (s.size() < kLargeMesh) return false;
-    for (std::uint32_t i = 0; i < s.size(); ++i) {
-        const PrimKind k = s.kind(i);
-        if (k != PrimKind::Triangle && !(k == PrimKind::Polygon && s.polygons[s.prims[i].index].count == 3)) return false;
-    }
+    for (std::uint32_t i = 0; i < s.size(); ++i)
+        if (!tested_as_triangle(s, i)) return false;
     return true;
 }
 

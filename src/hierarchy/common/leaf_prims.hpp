@@ -19,6 +19,12 @@ struct LeafPrim {
     bool as_triangle = false;
 };
 
+/// Whether primitive `id` is tested as a triangle: a triangle, or a polygon of three vertices.
+inline bool tested_as_triangle(const Scene& s, std::uint32_t id) {
+    const PrimRef& r = s.prims[id];
+    return r.kind == PrimKind::Triangle || (r.kind == PrimKind::Polygon && s.polygons[r.index].count == 3);
+}
+
 /// `refs` (primitive ids in leaf order) as LeafPrims.
 inline std::vector<LeafPrim> leaf_prims(const Scene& s, const std::vector<std::uint32_t>& refs) {
     std::vector<LeafPrim> out(refs.size());
