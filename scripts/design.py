@@ -212,7 +212,11 @@ def main():
     ap.add_argument("--sweep-scenes", default=",".join(SPD), help="scenes of the grid and kd sweeps ('' for none)")
     ap.add_argument("--sweep-dist", default="spd")
     ap.add_argument("--from", dest="from_raw", help="render from a raw JSON file this script wrote, running nothing")
+    ap.add_argument("--merge", help="run only --scenes x --dists x --families and put those rows in place of the "
+                    "same rows of this raw JSON file (the rest, and its sweeps, kept with their date)")
     a = ap.parse_args()
+    if a.merge and a.from_raw:
+        sys.exit("design.py: --merge runs rows; --from runs none: one or the other")
     rows = []
     raw_sweeps = {}
     if a.from_raw:
@@ -233,12 +237,37 @@ def main():
             doc, secs = run(a.binary, path, dist, a.families, a.size, a.sample, a.costs)
             for r in doc["results"]:
                 rows.append((os.path.basename(path), dist, {"sample": doc["sample"], "test_rays": doc["test_rays"]}, r))
-    if not a.from_raw and a.sweep_scenes:
+    reruns = []
+    if a.merge:
+        raw = json.load(open(a.merge))
+        fresh = {(r[0], r[1], r[3]["family"]) for r in rows}
+        kept = [r for r in raw["rows"] if (r[0], r[1], r[3]["family"]) not in fresh]
+        reruns = raw.get("reruns", []) + [{"date": stamp, "scenes": sorted({x[0] for x in fresh}),
+                                            "dists": sorted({x[1] for x in fresh}),
+                                            "families": sorted({x[2] for x in fresh})}]
+        fam_order = {}
+        for r in raw["rows"]:
+            fam_order.setdefault(r[3]["family"], len(fam_order))
+        for r in rows:
+            r[3]["run"] = stamp
+        rows = kept + rows
+        order = {s: i for i, s in enumerate(os.path.basename(scene_path(x)) for x in SPD + MESHES)}
+        dists = ["camera", "shadow", "ao", "diffuse", "spd"]
+        rows.sort(key=lambda r: (order.get(r[0], len(order)), dists.index(r[1]) if r[1] in dists else 9,
+                                 fam_order.get(r[3]["family"], len(fam_order))))
+        stamp, raw_sweeps = raw["date"], raw["sweeps"]
+        a.size, a.sample, a.families, a.sweep_dist = raw["size"], raw["sample"], raw["families"], raw["sweep_dist"]
+        a.sweep_scenes = ""
+    elif a.from_raw:
+        reruns = raw.get("reruns", [])
+    if not a.from_raw and not a.merge and a.sweep_scenes:
         scenes = [scene_path(x) for x in a.sweep_scenes.split(",")]
         raw_sweeps = sweep_runs(a, [x for x in scenes if x.startswith("builtin:") or os.path.exists(x)])
     if not a.from_raw:
         head = {"date": stamp, "size": a.size, "sample": a.sample, "families": a.families, "sweep_dist": a.sweep_dist,
                 "sweeps": raw_sweeps}
+        if reruns:
+            head["reruns"] = reruns
         with open(os.path.splitext(a.out)[0] + ".json", "w") as f:  # one row per line
             f.write("{\n" + "".join(f" {json.dumps(k)}: {json.dumps(v)},\n" for k, v in head.items()) + ' "rows": [\n')
             f.write(",\n".join("  " + json.dumps(r) for r in rows) + "\n ]\n}\n")
@@ -248,7 +277,10 @@ def main():
              "pinned to one core (`taskset -c 0`).", "",
              f"Machine: {cpu_name()}, {os.cpu_count()} hardware threads, shared with other jobs while this ran "
              f"(absolute ns are noisy; designed, yardstick and Embree ran back to back on the same rays). "
-             f"Date: {stamp}.", "",
+             f"Date: {stamp}." + "".join(
+                 f" Rows run again on {x['date']} (the code of that day, the rest of the table unchanged; each row's "
+                 f"designed structure, yardstick, Embree and A/A control still ran in one evaluation): "
+                 f"the {', '.join(x['families'])} rows of {', '.join(x['scenes'])} for {', '.join(x['dists'])} rays." for x in reruns), "",
              "The designed structure, its yardstick and Embree are timed in rounds of one pass each, every round "
              "in a new order. Timed passes repeat the same rays, and the branch predictor learns them: a "
              "structure timed alone, or beside an identical twin, runs faster than beside a different structure "
