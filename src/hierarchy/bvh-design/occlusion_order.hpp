@@ -33,7 +33,7 @@ public:
     /// `order[i]`: interior node i's order byte (occlusion_bits).
     DesignedBvh(const Scene& s, BvhData data, std::vector<std::uint8_t> order)
         : HierarchyImpl(s), bvh_(s, "bvh-design", std::move(data), true), order_(std::move(order)),
-          nodes_(bvh_.data().nodes) {
+          nodes_(bvh_.walk_nodes()) {
         for (std::size_t i = 0; i < nodes_.size(); ++i)
             if (!nodes_[i].leaf && nodes_[i].count == 2) nodes_[i].count = 2u | std::uint32_t{order_[i]} << kOrderShift;
     }
@@ -155,7 +155,7 @@ private:
 
     Bvh bvh_;
     std::vector<std::uint8_t> order_;
-    /// bvh_'s nodes, each binary interior node's order byte in its `count` from bit kOrderShift:
+    /// bvh_'s walk nodes, each binary interior node's order byte in its `count` from bit kOrderShift:
     /// the walk reads the order with the node. (Read from order_, a load apart whose result the
     /// next step waited for, the walk took 8-10% longer per ray on the same operations, and its
     /// gain over bvh-sah's walk on shadow rays was 1-14 points smaller: lattice 13.8% against 28.3%,

@@ -14,16 +14,28 @@ PrimInfo::PrimInfo(const Scene& s) : bounds(s.size()), centroids(s.size()) {
 
 Bvh::Bvh(const Scene& s, std::string name, BvhData data, bool ordered)
     : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered), prims_(leaf_prims(s, d_.refs)),
-      packs_(prims_),
       has_triangles_(std::any_of(prims_.begin(), prims_.end(), [](const LeafPrim& p) { return p.as_triangle; })) {
-    if (packs_.active()) prims_ = {};  // the packs hold every reference
+    // The leaves in leaf order (their references' order), so that their packs keep it.
+    std::vector<std::uint32_t> leaves;
+    for (std::uint32_t i = 0; i < d_.nodes.size(); ++i)
+        if (d_.nodes[i].leaf) leaves.push_back(i);
+    std::stable_sort(leaves.begin(), leaves.end(),
+                     [&](std::uint32_t a, std::uint32_t b) { return d_.nodes[a].index < d_.nodes[b].index; });
+    std::vector<std::pair<std::uint32_t, std::uint32_t>> ranges;
+    ranges.reserve(leaves.size());
+    for (std::uint32_t i : leaves) ranges.push_back({d_.nodes[i].index, std::uint32_t(d_.nodes[i].count)});
+    const std::vector<std::uint32_t> lanes = packs_.pack(prims_, ranges);
+    if (!packs_.active()) return;
+    prims_ = {};  // the packs hold every reference
+    walk_nodes_ = d_.nodes;
+    for (std::size_t k = 0; k < leaves.size(); ++k) walk_nodes_[leaves[k]].index = lanes[k];
 }
 
 StructureStats Bvh::compute_structure() const {
     StructureStats s = tree_structure(
         d_.nodes, [](const Node& n) { return n.leaf != 0; }, [](const Node& n) { return std::uint32_t(n.count); });
-    s.bytes = d_.nodes.size() * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) + prims_.size() * sizeof(LeafPrim) +
-              packs_.bytes();
+    s.bytes = (d_.nodes.size() + walk_nodes_.size()) * sizeof(Node) + d_.refs.size() * sizeof(std::uint32_t) +
+              prims_.size() * sizeof(LeafPrim) + packs_.bytes();
     s.limits = d_.limits;
     // A binary node's two boxes are tested at once (pair_entry); a wider node's one by one.
     s.box_lanes = std::all_of(d_.nodes.begin(), d_.nodes.end(), [](const Node& n) { return n.leaf || n.count == 2; }) ? 2 : 1;

@@ -107,8 +107,16 @@ public:
     /// emit_model with an any-hit order byte per node (`any_order[i]` for node i, as
     /// ModelNode::any_order without its flag) on every two-child interior node; none if empty.
     bool emit_model_ordered(ModelSink& sink, std::span<const std::uint8_t> any_order) const;
-    /// The built nodes and references (a traversal of another order reads them: bvh-design).
+    /// The built nodes and references (the model's and the statistics'; a leaf's `index` is its
+    /// first reference in BvhData::refs).
     const BvhData& data() const { return d_; }
+    /// The nodes as this BVH's walk reads them (a walk of another order copies them: bvh-design):
+    /// data().nodes, but where the leaves' triangles are in packs (leaf_packs.hpp) a leaf's
+    /// `index` is its first lane there (the packs start every leaf at a pack's first lane, so the
+    /// references' positions no longer say where a leaf's triangles are).
+    const NodeArray& walk_nodes() const { return walk_nodes_.empty() ? d_.nodes : walk_nodes_; }
+    /// The leaves' triangles in packs, inactive where some reference is not tested as a triangle.
+    const LeafPacks& packs() const { return packs_; }
     /// The order of an ordered BVH's any-hit (occlusion) queries. LeavesFirst: a node's leaf
     /// children before its interior ones (only a leaf can end the query), nearest first within
     /// each, a tie to the later child: a large occluder held high in the tree (a floor, a wall) is
@@ -120,10 +128,10 @@ public:
     void set_occlusion_order(OcclusionOrder o) { occlusion_ = o; }
     OcclusionOrder occlusion_order() const { return occlusion_; }
 
-    /// For another walk of the same nodes (bvh-design's occlusion order): leaf `n`'s primitive
-    /// tests as this BVH's own walk makes them (with RealPrimTest, on its triangle copies in leaf
-    /// order with the ray's shear `shear`, shear_of), counted alike; true when an any-hit query
-    /// ends. `test` as trace_with takes it.
+    /// For another walk of the same nodes (bvh-design's occlusion order): leaf `n` (of
+    /// walk_nodes() or a copy) tested as this BVH's own walk tests it (with RealPrimTest, on its
+    /// triangle copies in leaf order with the ray's shear `shear`, shear_of), counted alike; true
+    /// when an any-hit query ends. `test` as trace_with takes it.
     template <class C, Query Q, class PrimTest>
     bool test_leaf_of(const Node& n, const Ray& ray, const RayShear& shear, Hit& hit, C& counting, bool& found,
                       PrimTest& test) const {
@@ -132,8 +140,8 @@ public:
     /// The shear a walk hands test_leaf_of: made only for a tree with triangles to test.
     RayShear shear_of(const Ray& ray) const { return has_triangles_ ? RayShear(ray.d) : RayShear(); }
     /// Fetches what a visit of node `i` reads first (a walk about to wait on memory).
-    void prefetch_node(std::uint32_t i) const { prefetch(d_.nodes[i]); }
-    /// Fetches the leaf primitives from leaf order position `first` (a leaf's Node::index).
+    void prefetch_node(std::uint32_t i) const { prefetch(walk_nodes().data(), walk_nodes()[i]); }
+    /// Fetches the leaf primitives from `first` (a leaf's Node::index in walk_nodes()).
     void prefetch_prims(std::uint32_t first) const {
         __builtin_prefetch(packs_.active() ? packs_.at(first) : static_cast<const void*>(prims_.data() + first));
     }
@@ -169,7 +177,7 @@ private:
         // Stack bound: along any path at most kMaxFanout - 1 siblings wait per level.
         Entry stack[kMaxDepth * (kMaxFanout - 1) + 2];
         int sp = 0;
-        const Node* nodes = d_.nodes.data();
+        const Node* nodes = walk_nodes().data();
         const RayInv ri(ray);
         const PairRay pair_ray(ri);
         // Three divisions a ray pays only where it reaches a leaf with triangles to test (not in a
@@ -204,8 +212,8 @@ private:
                     counting.box();
                     counting.box();
                     // What either child's visit reads, fetched while their boxes are tested.
-                    prefetch(nodes[n.index]);
-                    prefetch(nodes[n.index + 1]);
+                    prefetch(nodes, nodes[n.index]);
+                    prefetch(nodes, nodes[n.index + 1]);
                     float ta, tb;
                     pair_entry(nodes[n.index].box, nodes[n.index + 1].box, pair_ray, ray.tmin, limit, ta, tb);
                     Entry a{n.index, ta, e.depth + 1}, b{n.index + 1, tb, e.depth + 1};
@@ -314,11 +322,12 @@ private:
     }
 
     /// Incoherent rays wait on memory: what a visit of `n` reads first, fetched ahead.
-    void prefetch(const Node& n) const {
-        if (!n.leaf) __builtin_prefetch(d_.nodes.data() + n.index);
+    /// `nodes`: walk_nodes(), which the walk holds.
+    void prefetch(const Node* nodes, const Node& n) const {
+        if (!n.leaf) __builtin_prefetch(nodes + n.index);
         else if (!packs_.active()) __builtin_prefetch(prims_.data() + n.index);
         else if (n.count > 0) {
-            // Every line of the packs the leaf's lanes lie in (a leaf of two can span two packs).
+            // Every line of the leaf's packs.
             const char* a = static_cast<const char*>(packs_.at(n.index));
             const char* b = static_cast<const char*>(packs_.at(n.index + n.count - 1)) + sizeof(TriPack<4>);
             for (; a < b; a += 64) __builtin_prefetch(a);
@@ -331,6 +340,7 @@ private:
     OcclusionOrder occlusion_ = OcclusionOrder::AsClosest;
     std::vector<LeafPrim> prims_;  ///< BvhData::refs as their tests need them, in leaf order (none with packs_)
     LeafPacks packs_;              ///< the same in packs of four, for a mesh (every reference a triangle)
+    NodeArray walk_nodes_;         ///< with packs_: d_.nodes, each leaf's index its first lane in packs_
     bool has_triangles_ = false;    ///< some LeafPrim is tested as a triangle (RayShear needed)
 };
 
