@@ -239,6 +239,8 @@ def main():
                 rows.append((os.path.basename(path), dist, {"sample": doc["sample"], "test_rays": doc["test_rays"]}, r))
     reruns = []
     if a.merge:
+        if not rows:
+            sys.exit("design.py: --merge ran no rows (no scene of --scenes present): nothing to merge")
         raw = json.load(open(a.merge))
         fresh = {(r[0], r[1], r[3]["family"]) for r in rows}
         kept = [r for r in raw["rows"] if (r[0], r[1], r[3]["family"]) not in fresh]
