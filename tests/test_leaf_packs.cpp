@@ -43,8 +43,9 @@ TEST(BvhLeafPacks, EveryLeafSpansTheFewestPacksAndHoldsItsReferences) {
                 continue;
             }
             ++leaves;
-            spanning_more += (b.index % 4 + b.count + 3) / 4 > (b.count + 3) / 4;
-            EXPECT_EQ((w.index % 4 + b.count + 3) / 4, (b.count + 3) / 4)
+            const std::uint32_t count = static_cast<std::uint32_t>(b.count);
+            spanning_more += (b.index % 4 + count + 3) / 4 > (count + 3) / 4;
+            EXPECT_EQ((w.index % 4 + count + 3) / 4, (count + 3) / 4)
                 << name << ": leaf " << i << " of " << b.count << " from lane " << w.index;
             for (std::uint32_t k = 0; k < b.count; ++k)
                 EXPECT_EQ(bvh->packs().id(w.index + k), bvh->data().refs[b.index + k]) << name << ": leaf " << i;

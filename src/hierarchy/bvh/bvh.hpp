@@ -13,6 +13,7 @@
 
 #include "../common/impl.hpp"
 #include "../common/leaf_prims.hpp"
+#include "../common/line_allocator.hpp"
 #include "leaf_packs.hpp"
 #include "pair_entry.hpp"
 
@@ -32,28 +33,11 @@ static_assert(sizeof(Node) == 32);
 inline constexpr int kMaxFanout = 8;
 inline constexpr int kMaxDepth = 100;
 
-/// Places a node array so that each pair of siblings that starts at an odd index (as every
+/// A node array placed so that each pair of siblings that starts at an odd index (as every
 /// builder lays out a binary node's children: the root, then pairs) lies in one 64-byte cache
-/// line: aligned to 64 bytes less one node. A binary visit reads both children's boxes and
-/// prefetches a child's pair as one line; from malloc's 16-byte alignment every pair straddled
-/// two lines, the second never prefetched.
-template <class T>
-struct PairLineAllocator {
-    static_assert(sizeof(T) == 32, "a pair of nodes fills a cache line");
-    using value_type = T;
-    PairLineAllocator() = default;
-    template <class U>
-    PairLineAllocator(const PairLineAllocator<U>&) {}
-    T* allocate(std::size_t n) {
-        auto* line = static_cast<std::byte*>(::operator new(n * sizeof(T) + sizeof(T), std::align_val_t{64}));
-        return reinterpret_cast<T*>(line + sizeof(T));
-    }
-    void deallocate(T* p, std::size_t) {
-        ::operator delete(reinterpret_cast<std::byte*>(p) - sizeof(T), std::align_val_t{64});
-    }
-    friend bool operator==(const PairLineAllocator&, const PairLineAllocator&) { return true; }
-};
-using NodeArray = std::vector<Node, PairLineAllocator<Node>>;
+/// line: a binary visit reads both children's boxes and prefetches a child's pair as one line;
+/// from malloc's 16-byte alignment every pair straddled two lines, the second never prefetched.
+using NodeArray = std::vector<Node, LineAllocator<Node, 1>>;
 
 struct BvhData {
     NodeArray nodes;                   ///< nodes[0] is the root

@@ -17,6 +17,7 @@
 #include "../common/impl.hpp"
 #include "../common/lanes_base.hpp"
 #include "../common/leaf_prims.hpp"
+#include "../common/line_allocator.hpp"
 #include "../common/tri_pack.hpp"
 #include "scene/watertight.hpp"
 
@@ -42,23 +43,10 @@ bool test_range(const TriPack<4>* packs, std::uint32_t first, std::uint32_t coun
 
 }  // namespace packs
 
-/// Places an array on a cache line: a pack of four (192 bytes with padding) then starts a line,
-/// and a test of it reads three lines, not four every other pack (malloc aligns to 16, the
-/// pack's type to 32).
-template <class T>
-struct LineAllocator {
-    static_assert(sizeof(T) % 64 == 0, "every element starts a line");
-    using value_type = T;
-    LineAllocator() = default;
-    template <class U>
-    LineAllocator(const LineAllocator<U>&) {}
-    T* allocate(std::size_t n) { return static_cast<T*>(::operator new(n * sizeof(T), std::align_val_t{64})); }
-    void deallocate(T* p, std::size_t) { ::operator delete(p, std::align_val_t{64}); }
-    friend bool operator==(const LineAllocator&, const LineAllocator&) { return true; }
-};
-
 /// Every leaf's references as lanes of packs, or none when some reference is not a triangle.
 struct LeafPacks {
+    /// Each pack (192 bytes with padding) starts a line: a test of it reads three lines, not
+    /// four every other pack.
     std::vector<TriPack<4>, LineAllocator<TriPack<4>>> packs;
 
     LeafPacks() = default;
