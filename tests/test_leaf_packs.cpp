@@ -62,6 +62,26 @@ TEST(BvhLeafPacks, EveryLeafSpansTheFewestPacksAndHoldsItsReferences) {
     EXPECT_GT(spanning_more, 30u);
 }
 
+TEST(BvhLeafPacks, AnEmptyLeafTakesNoLaneAndMovesNoLeafOn) {
+    std::vector<LeafPrim> prims(5);
+    for (std::uint32_t i = 0; i < prims.size(); ++i) {
+        prims[i].id = 10 + i;
+        prims[i].as_triangle = true;
+        prims[i].tri = Triangle{{0, 0, float(i)}, {1, 0, float(i)}, {0, 1, float(i)}};
+    }
+    // Leaves of 2, 0, 2 and 1 references: the second of two fits the first pack after the first
+    // leaf, the empty one between them changing nothing; the last goes on from lane 4.
+    const std::vector<std::pair<std::uint32_t, std::uint32_t>> leaves = {{0, 2}, {2, 0}, {2, 2}, {4, 1}};
+    bvh::LeafPacks lp;
+    const std::vector<std::uint32_t> lanes = lp.pack(prims, leaves);
+    EXPECT_EQ(lanes, (std::vector<std::uint32_t>{0, 2, 2, 4}));
+    ASSERT_EQ(lp.packs.size(), 2u);
+    for (std::uint32_t k = 0; k < prims.size(); ++k) {
+        EXPECT_EQ(lp.id(k), 10 + k);
+        EXPECT_EQ(lp.prim(k).tri.v0.z, float(k));
+    }
+}
+
 TEST(BvhLeafPacks, NoneWhereAReferenceIsNotATriangle) {
     const Scene s = builtin_scene("balls", 2);  // spheres and a polygon
     auto h = build_hierarchy(s, "bvh-sah");

@@ -64,8 +64,8 @@ struct LeafPacks {
         std::size_t next = 0;  // the first free lane
         for (const auto& [first, count] : leaves) {
             // A leaf goes on where the last one ended unless that spans a pack more than its count
-            // needs; then from the next pack.
-            if ((next % 4 + count + 3) / 4 > (count + 3) / 4) next = (next + 3) / 4 * 4;
+            // needs; then from the next pack. (An empty leaf needs no pack and moves nothing on.)
+            if (count > 0 && (next % 4 + count + 3) / 4 > (count + 3) / 4) next = (next + 3) / 4 * 4;
             lanes.push_back(static_cast<std::uint32_t>(next));
             packs.resize((next + count + 3) / 4);
             for (std::uint32_t k = 0; k < count; ++k) {
