@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cstddef>
-#include <new>
 #include <span>
 #include <string>
 #include <type_traits>
@@ -123,8 +122,6 @@ public:
     }
     /// The shear a walk hands test_leaf_of: made only for a tree with triangles to test.
     RayShear shear_of(const Ray& ray) const { return has_triangles_ ? RayShear(ray.d) : RayShear(); }
-    /// Fetches what a visit of node `i` reads first (a walk about to wait on memory).
-    void prefetch_node(std::uint32_t i) const { prefetch(walk_nodes().data(), walk_nodes()[i]); }
     /// Fetches the leaf primitives from `first` (a leaf's Node::index in walk_nodes()).
     void prefetch_prims(std::uint32_t first) const {
         __builtin_prefetch(packs_.active() ? packs_.at(first) : static_cast<const void*>(prims_.data() + first));
