@@ -90,9 +90,9 @@ def sweep_tables(raw, dist, counts=None, when=None):
         for scene, d, variants, *again in runs:
             best = min(variants, key=lambda r: r[1])
             best_ops = min(r[2] for r in variants)
-            re = again[0] if again else None
-            re_ns = f"{re['designed'][1]:.0f} / {re['best'][1]:.0f}" if re else "-"
-            re_ratio = f"{re['designed'][1] / re['best'][1]:.3f}" if re else "-"
+            retimed = again[0] if again else None
+            re_ns = f"{retimed['designed'][1]:.0f} / {retimed['best'][1]:.0f}" if retimed else "-"
+            re_ratio = f"{retimed['designed'][1] / retimed['best'][1]:.3f}" if retimed else "-"
             out.append(f"| {scene} | {d[1]:.0f} | `{best[0]}` | {best[1]:.0f} | {d[1] / best[1]:.3f} | {re_ns} | {re_ratio} | {d[2]:.1f} | {best[2]:.1f} | {best_ops:.1f} |")
     return out
 
