@@ -22,7 +22,7 @@ import sys
 import numpy as np
 
 SPD = ["balls", "gears", "lattice", "mount", "rings", "shells", "sombrero", "teapot", "tetra", "tree"]
-# Triangles (the SPD scenes have none: their triangles are three-vertex polygons), as docs/design.md.
+# Meshes of triangles, as docs/design.md.
 MESHES = ["/usr/share/assimp/models/glTF2/2CylinderEngine-glTF-Binary/2CylinderEngine.glb",
           "/usr/share/assimp/models/BLEND/yxa_1.blend"]
 VARIANTS = ["bvh-sah:c_trav=0.5", "bvh-sah", "bvh-sah:c_trav=2", "bvh-sah:c_trav=3", "bvh-sah:c_trav=5"]

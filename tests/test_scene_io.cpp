@@ -99,22 +99,22 @@ TEST_P(NffSpd, LoadsWithTheExpectedCountsAndKinds) {
 INSTANTIATE_TEST_SUITE_P(NffStandard, NffSpd,
                          ::testing::Values(SpdCase{"balls", 7382, 0, 1, 7381, 0, 3},
                                            SpdCase{"gears", 9345, 0, 9345, 0, 0, 5},
-                                           SpdCase{"mount", 8196, 0, 8192, 4, 0, 1},
+                                           SpdCase{"mount", 8196, 8192, 0, 4, 0, 1},
                                            SpdCase{"rings", 8401, 0, 1, 4200, 4200, 3},
-                                           SpdCase{"teapot", 9264, 0, 9264, 0, 0, 2},
-                                           SpdCase{"tetra", 4096, 0, 4096, 0, 0, 1},
+                                           SpdCase{"teapot", 9264, 9120, 144, 0, 0, 2},
+                                           SpdCase{"tetra", 4096, 4096, 0, 0, 0, 1},
                                            SpdCase{"tree", 8191, 0, 1, 4095, 4095, 7},
                                            SpdCase{"lattice", 8281, 0, 0, 2197, 6084, 6},
                                            SpdCase{"shells", 5761, 0, 0, 5761, 0, 1},
-                                           SpdCase{"sombrero", 1922, 0, 1922, 0, 0, 1}),
+                                           SpdCase{"sombrero", 1922, 1922, 0, 0, 0, 1}),
                          [](const auto& info) { return std::string(info.param.name); });
 
 INSTANTIATE_TEST_SUITE_P(NffLarge, NffSpd,
                          ::testing::Values(SpdCase{"balls-s5", 66431, 0, 1, 66430, 0, 3},
                                            SpdCase{"gears-s8", 74753, 0, 74753, 0, 0, 5},
-                                           SpdCase{"mount-s8", 131076, 0, 131072, 4, 0, 1},
+                                           SpdCase{"mount-s8", 131076, 131072, 0, 4, 0, 1},
                                            SpdCase{"rings-s10", 23101, 0, 1, 11550, 11550, 3},
-                                           SpdCase{"tetra-s8", 65536, 0, 65536, 0, 0, 1},
+                                           SpdCase{"tetra-s8", 65536, 65536, 0, 0, 0, 1},
                                            SpdCase{"tree-s14", 65535, 0, 1, 32767, 32767, 7}),
                          [](const auto& info) {
                              std::string n = info.param.name;
@@ -155,9 +155,9 @@ TEST(NffSpdDetail, RingsConesAndTeapotPatches) {
     EXPECT_EQ(c.apex, (Vec3{0.287693f, 1.7277f, 0}));
     EXPECT_EQ(c.base_radius, 0.07412f);
     Scene t = read_nff_file(teapot);
-    std::size_t three = 0;
-    for (const Polygon& p : t.polygons) three += p.count == 3;
-    EXPECT_GE(three, 9120u);  // every `pp 3` is kept as one polygon
+    // Each of the 9,120 `pp 3` patches is one triangle, each of the floor's 144 `p 4` one polygon.
+    EXPECT_EQ(count(t, PrimKind::Triangle), 9120u);
+    EXPECT_EQ(count(t, PrimKind::Polygon), 144u);
 }
 
 // --- NFF: the grammar on small inputs --------------------------------------------------------
@@ -180,8 +180,9 @@ TEST(NffGrammar, EachEntityIsOnePrimitiveInFileOrder) {
         "grammar.nff");
     ASSERT_EQ(s.size(), 6u);
     EXPECT_TRUE(s.warnings.empty());
+    // `p 3` is stored as a triangle (the same test), `pp 4` as a polygon.
     const PrimKind kinds[] = {PrimKind::Sphere, PrimKind::Cone, PrimKind::Cone,
-                              PrimKind::Polygon, PrimKind::Polygon, PrimKind::Sphere};
+                              PrimKind::Triangle, PrimKind::Polygon, PrimKind::Sphere};
     for (std::uint32_t id = 0; id < 6; ++id) EXPECT_EQ(s.kind(id), kinds[id]) << id;
     // Material 0 is the default one added for the sphere that precedes any `f`.
     ASSERT_EQ(s.materials.size(), 3u);
@@ -195,8 +196,14 @@ TEST(NffGrammar, EachEntityIsOnePrimitiveInFileOrder) {
     EXPECT_EQ(s.cones[1].base_radius, 1.0f);
     EXPECT_EQ(s.cones[1].apex_radius, 0.5f);
     EXPECT_EQ(s.cones[0].apex, s.cones[1].apex);
-    EXPECT_EQ(s.polygons[1].count, 4u);  // not triangulated
-    EXPECT_EQ(s.polygon_vertices[s.polygons[1].first + 2], (Vec3{1, 1, 1}));
+    ASSERT_EQ(s.triangles.size(), 1u);
+    EXPECT_EQ(s.triangles[0].v0, (Vec3{0, 0, 0}));
+    EXPECT_EQ(s.triangles[0].v1, (Vec3{1, 0, 0}));
+    EXPECT_EQ(s.triangles[0].v2, (Vec3{0, 1, 0}));
+    ASSERT_EQ(s.polygons.size(), 1u);
+    EXPECT_EQ(s.polygons[0].count, 4u);  // not triangulated
+    EXPECT_EQ(s.polygon_vertices.size(), 4u);  // the triangle's vertices are not left in the pool
+    EXPECT_EQ(s.polygon_vertices[s.polygons[0].first + 2], (Vec3{1, 1, 1}));
     EXPECT_EQ(s.background, (Vec3{0.1f, 0.2f, 0.3f}));
     ASSERT_EQ(s.lights.size(), 2u);
     EXPECT_EQ(s.lights[0].color, (Vec3{1, 1, 1}));
@@ -317,7 +324,7 @@ TEST(NffDegenerate, SkippedWithWarningsAndConsecutiveIds) {
         "p 3\n0 0 0\n1 0 0\n2 0 0\n"                       // 16: zero-area triangle, collinear
         "pp 3\n0 0 0 0 0 1\n0 0 0 0 0 1\n1 1 0 0 0 1\n"     // 20: two vertices coincide
         "c 0 0 0 1 0 0 1 0\n"                              // 24: id 2, a true cone (one radius 0)
-        "p 3\n0 0 0\n1 0 0\n0 1 0\n",                      // 25: id 3
+        "p 4\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n",               // 25: id 3
         "degen.nff");
     ASSERT_EQ(s.size(), 4u);
     EXPECT_EQ(s.kind(0), PrimKind::Sphere);
@@ -326,7 +333,7 @@ TEST(NffDegenerate, SkippedWithWarningsAndConsecutiveIds) {
     EXPECT_EQ(s.kind(3), PrimKind::Polygon);
     EXPECT_EQ(s.spheres[s.prims[1].index].center, (Vec3{1, 0, 0}));
     EXPECT_EQ(s.polygons.size(), 1u);
-    EXPECT_EQ(s.polygon_vertices.size(), 3u);  // nothing left behind by the skipped polygons
+    EXPECT_EQ(s.polygon_vertices.size(), 4u);  // nothing left behind by the skipped polygons
     const std::vector<std::string> want = {
         "degen.nff:2: degenerate sphere skipped (zero radius)",
         "degen.nff:3: degenerate polygon skipped (collinear vertices)",
@@ -645,13 +652,14 @@ void expect_tetra_match(const std::string& file, int level) {
     Scene f = read_nff_file(path), g = builtin_scene("tetra", level);
     ASSERT_EQ(f.size(), g.size());
     for (std::uint32_t id = 0; id < f.size(); ++id) {
-        const Polygon& p = f.polygons[f.prims[id].index];
+        // The file's `p 3` polygons are stored as triangles, as the built-in scene's are.
+        ASSERT_EQ(f.kind(id), PrimKind::Triangle) << id;
+        const Triangle& p = f.triangles[f.prims[id].index];
         const Triangle& t = g.triangles[g.prims[id].index];
-        ASSERT_EQ(p.count, 3u);
         // Dyadic coordinates: exact.
-        ASSERT_EQ(f.polygon_vertices[p.first], t.v0) << id;
-        ASSERT_EQ(f.polygon_vertices[p.first + 1], t.v1) << id;
-        ASSERT_EQ(f.polygon_vertices[p.first + 2], t.v2) << id;
+        ASSERT_EQ(p.v0, t.v0) << id;
+        ASSERT_EQ(p.v1, t.v1) << id;
+        ASSERT_EQ(p.v2, t.v2) << id;
     }
     EXPECT_EQ(f.camera.from, g.camera.from);
     EXPECT_EQ(f.camera.at, g.camera.at);

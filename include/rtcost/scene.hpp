@@ -93,7 +93,8 @@ public:
     std::uint32_t add(const Triangle& t, std::uint32_t material);
     std::uint32_t add(const Sphere& s, std::uint32_t material);
     std::uint32_t add(const Cone& c, std::uint32_t material);
-    /// Adds a polygon over `verts`; returns false (adding nothing) when it is degenerate. A
+    /// Adds a polygon over `verts`; returns false (adding nothing) when it is degenerate. One of
+    /// three vertices is added as a Triangle (the same test and hits). A
     /// polygon of more than three vertices that is not planar (a vertex off its plane by more
     /// than 1e-6 of its size) is flattened onto the plane of its normal, keeping its outline in
     /// the projection the intersection uses; `flattened` (if given) says so when the polygon is

@@ -129,6 +129,16 @@ bool Scene::add_polygon(std::span<const Vec3> verts, std::uint32_t material, std
         return false;
     }
     if (flattened) *flattened = false;
+    if (p.count == 3) {
+        // A polygon of three vertices is a triangle: the same exact test (intersect(Polygon)
+        // makes it), so it is stored, counted and priced as one. Kept apart, its tests were
+        // priced at a polygon's fitted ns, which polygons whose edges carry their cost set.
+        const Triangle t{polygon_vertices[p.first], polygon_vertices[p.first + 1], polygon_vertices[p.first + 2]};
+        polygon_vertices.resize(p.first);
+        const std::uint32_t added = add(t, material);
+        if (id) *id = added;
+        return true;
+    }
     const Flattening f = p.count > 3 ? flatten_polygon(p, polygon_vertices) : Flattening::none;
     if (f != Flattening::none) {
         if (flattened) *flattened = f == Flattening::nonplanar;

@@ -100,20 +100,13 @@ std::uint32_t collapse(const bvh::BvhData& bd, std::vector<Node<W>>& out) {
     return static_cast<std::uint32_t>(root_count);
 }
 
-/// Triangle `id` as a pack stores it: a triangle, or a three-vertex polygon (which
-/// intersect(Polygon) tests as exactly this triangle); false for other primitives.
+/// Triangle `id` as a pack stores it; false for other primitives (Scene::add_polygon stores a
+/// polygon of three vertices as a triangle).
 bool pack_triangle(const Scene& s, std::uint32_t id, Triangle& t) {
     const PrimRef& r = s.prims[id];
-    if (r.kind == PrimKind::Triangle) {
-        t = s.triangles[r.index];
-        return true;
-    }
-    if (r.kind == PrimKind::Polygon && s.polygons[r.index].count == 3) {
-        const Vec3* v = s.polygon_vertices.data() + s.polygons[r.index].first;
-        t = Triangle{v[0], v[1], v[2]};
-        return true;
-    }
-    return false;
+    if (r.kind != PrimKind::Triangle) return false;
+    t = s.triangles[r.index];
+    return true;
 }
 
 /// Appends a leaf to the arena: `tris` K to a pack, then `others`. Sets the lane's `child` and

@@ -38,7 +38,7 @@ inline constexpr std::uint32_t kEmpty = 0xffffffffu;
 /// Bound on depth (the collapsed tree is never deeper than the binary one).
 inline constexpr int kMaxDepth = 100;
 
-/// A leaf's primitive other than a triangle (or a three-vertex polygon): tested through
+/// A leaf's primitive other than a triangle: tested through
 /// Scene::intersect, as test_prim does.
 struct Other {
     std::uint32_t id = 0;

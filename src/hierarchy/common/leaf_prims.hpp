@@ -10,8 +10,7 @@
 
 namespace rtcost {
 
-/// One reference: the id, the kind counted and, for a triangle or a three-vertex polygon (which
-/// Scene::intersect tests as that same triangle), its vertices.
+/// One reference: the id, the kind counted and, for a triangle, its vertices.
 struct LeafPrim {
     Triangle tri;
     std::uint32_t id = 0;
@@ -19,11 +18,9 @@ struct LeafPrim {
     bool as_triangle = false;
 };
 
-/// Whether primitive `id` is tested as a triangle: a triangle, or a polygon of three vertices.
-inline bool tested_as_triangle(const Scene& s, std::uint32_t id) {
-    const PrimRef& r = s.prims[id];
-    return r.kind == PrimKind::Triangle || (r.kind == PrimKind::Polygon && s.polygons[r.index].count == 3);
-}
+/// Whether primitive `id` is tested as a triangle (Scene::add_polygon stores a polygon of three
+/// vertices as one).
+inline bool tested_as_triangle(const Scene& s, std::uint32_t id) { return s.prims[id].kind == PrimKind::Triangle; }
 
 /// `refs` (primitive ids in leaf order) as LeafPrims.
 inline std::vector<LeafPrim> leaf_prims(const Scene& s, const std::vector<std::uint32_t>& refs) {
@@ -35,10 +32,6 @@ inline std::vector<LeafPrim> leaf_prims(const Scene& s, const std::vector<std::u
         p.kind = r.kind;
         if (r.kind == PrimKind::Triangle) {
             p.tri = s.triangles[r.index];
-            p.as_triangle = true;
-        } else if (r.kind == PrimKind::Polygon && s.polygons[r.index].count == 3) {
-            const Vec3* v = s.polygon_vertices.data() + s.polygons[r.index].first;
-            p.tri = Triangle{v[0], v[1], v[2]};
             p.as_triangle = true;
         }
     }

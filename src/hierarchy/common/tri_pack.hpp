@@ -8,7 +8,7 @@
 
 namespace rtcost {
 
-/// `K` triangles of a leaf (triangles and three-vertex polygons) side by side, one lane each:
+/// `K` triangles of a leaf side by side, one lane each:
 /// `v[3 i + a]` is vertex i's coordinate on axis a. Lanes past the leaf's count are unused.
 template <int K>
 struct alignas(32) TriPack {
