@@ -43,6 +43,11 @@ UnitCosts UnitCosts::typical() {
     // split down to trees five times the cache (teapot: 5 MB, 22% slower than kd-sah's best).
     // The cache size is the fitting machine's, not this one's, so that a design is the same on
     // every machine; a costs file from `calibrate` carries the machine's own.
+    // Fitted while the SPD scenes' triangles were polygons of three vertices (Scene::add_polygon
+    // stores them as triangles since 2026-12-07): the triangle price below is the meshes', the
+    // polygon price mostly those triangles'. Not refitted yet, so kd-design now prices mount's,
+    // tetra's, teapot's and sombrero's triangles at the meshes' price (mount: 21,551 leaves,
+    // against 14,044 at the polygon price); docs/design.md's rows of those scenes were rerun.
     UnitCosts c;
     c.box = 3.91;
     c.box_simd = 1.09;
