@@ -66,7 +66,6 @@ TEST(BvhLeafPacks, AnEmptyLeafTakesNoLaneAndMovesNoLeafOn) {
     std::vector<LeafPrim> prims(5);
     for (std::uint32_t i = 0; i < prims.size(); ++i) {
         prims[i].id = 10 + i;
-        prims[i].as_triangle = true;
         prims[i].tri = Triangle{{0, 0, float(i)}, {1, 0, float(i)}, {0, 1, float(i)}};
     }
     // Leaves of 2, 0, 2 and 1 references: the second of two fits the first pack after the first

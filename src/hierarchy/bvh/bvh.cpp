@@ -14,7 +14,7 @@ PrimInfo::PrimInfo(const Scene& s) : bounds(s.size()), centroids(s.size()) {
 
 Bvh::Bvh(const Scene& s, std::string name, BvhData data, bool ordered)
     : HierarchyImpl(s), name_(std::move(name)), d_(std::move(data)), ordered_(ordered), prims_(leaf_prims(s, d_.refs)),
-      has_triangles_(std::any_of(prims_.begin(), prims_.end(), [](const LeafPrim& p) { return p.as_triangle; })) {
+      has_triangles_(std::any_of(prims_.begin(), prims_.end(), [](const LeafPrim& p) { return p.kind == PrimKind::Triangle; })) {
     // The leaves in leaf order (their references' order), so that their packs keep it.
     std::vector<std::uint32_t> leaves;
     for (std::uint32_t i = 0; i < d_.nodes.size(); ++i)

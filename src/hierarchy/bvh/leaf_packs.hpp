@@ -56,7 +56,7 @@ struct LeafPacks {
     template <class Leaves>
     std::vector<std::uint32_t> pack(const std::vector<LeafPrim>& prims, const Leaves& leaves) {
         packs.clear();
-        if (prims.empty() || !std::all_of(prims.begin(), prims.end(), [](const LeafPrim& p) { return p.as_triangle; }))
+        if (prims.empty() || !std::all_of(prims.begin(), prims.end(), [](const LeafPrim& p) { return p.kind == PrimKind::Triangle; }))
             return {};
         std::vector<std::uint32_t> lanes;
         lanes.reserve(leaves.size());
@@ -90,7 +90,6 @@ struct LeafPacks {
         p.tri = Triangle{{q.v[0][l], q.v[1][l], q.v[2][l]}, {q.v[3][l], q.v[4][l], q.v[5][l]}, {q.v[6][l], q.v[7][l], q.v[8][l]}};
         p.id = q.id[l];
         p.kind = q.kind[l];
-        p.as_triangle = true;
         return p;
     }
     std::uint32_t id(std::uint32_t k) const { return packs[k / 4].id[k % 4]; }

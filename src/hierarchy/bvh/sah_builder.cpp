@@ -210,10 +210,7 @@ bool large_triangle_mesh(const Scene& s) {
     // Every primitive tested as a triangle: the binary BVHs then test their leaves a pack of
     // four at a time (leaf_packs.hpp).
     constexpr std::size_t kLargeMesh = std::size_t{1} << 16;
-    if (s.size() < kLargeMesh) return false;
-    for (std::uint32_t i = 0; i < s.size(); ++i)
-        if (!tested_as_triangle(s, i)) return false;
-    return true;
+    return s.size() >= kLargeMesh && s.kind_counts()[static_cast<int>(PrimKind::Triangle)] == s.size();
 }
 
 SahOptions sah_leaf_costs(const Scene& s, SahOptions o) {

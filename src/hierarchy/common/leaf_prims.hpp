@@ -10,17 +10,13 @@
 
 namespace rtcost {
 
-/// One reference: the id, the kind counted and, for a triangle, its vertices.
+/// One reference: the id, the kind counted and, for a triangle, its vertices (tested from
+/// here; any other kind through the scene).
 struct LeafPrim {
     Triangle tri;
     std::uint32_t id = 0;
     PrimKind kind = PrimKind::Triangle;
-    bool as_triangle = false;
 };
-
-/// Whether primitive `id` is tested as a triangle (Scene::add_polygon stores a polygon of three
-/// vertices as one).
-inline bool tested_as_triangle(const Scene& s, std::uint32_t id) { return s.prims[id].kind == PrimKind::Triangle; }
 
 /// `refs` (primitive ids in leaf order) as LeafPrims.
 inline std::vector<LeafPrim> leaf_prims(const Scene& s, const std::vector<std::uint32_t>& refs) {
@@ -30,10 +26,7 @@ inline std::vector<LeafPrim> leaf_prims(const Scene& s, const std::vector<std::u
         const PrimRef& r = s.prims[refs[k]];
         p.id = refs[k];
         p.kind = r.kind;
-        if (r.kind == PrimKind::Triangle) {
-            p.tri = s.triangles[r.index];
-            p.as_triangle = true;
-        }
+        if (r.kind == PrimKind::Triangle) p.tri = s.triangles[r.index];
     }
     return out;
 }
@@ -43,7 +36,7 @@ inline std::vector<LeafPrim> leaf_prims(const Scene& s, const std::vector<std::u
 template <class C>
 inline bool test_prim(const Scene& scene, const LeafPrim& p, const Ray& ray, const RayShear& sh, Hit& hit,
                       C& counting) {
-    if (!p.as_triangle) return test_prim(scene, p.id, ray, hit, counting);
+    if (p.kind != PrimKind::Triangle) return test_prim(scene, p.id, ray, hit, counting);
     counting.prim(p.kind);
     Ray r = ray;
     r.tmax = hit.t < ray.tmax ? hit.t : ray.tmax;
