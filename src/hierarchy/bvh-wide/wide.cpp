@@ -130,7 +130,6 @@ void append_packs(std::vector<BvhWide::Data::Block>& arena, const Scene& s, cons
             for (int i = 0; i < 3; ++i)
                 for (int a = 0; a < 3; ++a) q.v[3 * i + a][l] = v[i][a];
             q.id[l] = id;
-            q.kind[l] = s.kind(id);
         }
     }
     auto* o = reinterpret_cast<Other*>(pk + packs);

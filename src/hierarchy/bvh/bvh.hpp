@@ -308,8 +308,8 @@ private:
         if (!n.leaf) __builtin_prefetch(nodes + n.index);
         else if (!packs_.active()) __builtin_prefetch(prims_.data() + n.index);
         else if (n.count > 0) {
-            // Every line of the leaf's packs.
-            const char* a = static_cast<const char*>(packs_.at(n.index));
+            // Every line of the leaf's packs (a pack may start half a line in).
+            const char* a = reinterpret_cast<const char*>(reinterpret_cast<std::uintptr_t>(packs_.at(n.index)) & ~std::uintptr_t{63});
             const char* b = static_cast<const char*>(packs_.at(n.index + n.count - 1)) + sizeof(TriPack<4>);
             for (; a < b; a += 64) __builtin_prefetch(a);
         }

@@ -2,7 +2,7 @@
 // A binary BVH's references in packs of four triangles (TriPack<4>), tested four at a time in the
 // baseline's lanes by bvh-wide's SIMD watertight test: the same hits, counts and order as the
 // scalar loop over LeafPrims. Used where every reference is tested as a triangle (meshes); the
-// packs then replace the LeafPrim copies, 48 bytes a triangle against 44. A leaf's triangles
+// packs then replace the LeafPrim copies, 40 bytes a triangle against 44. A leaf's triangles
 // follow the last leaf's lanes unless they would then span more packs than their count needs, in
 // which case they start the next pack. (Packed end to end, as the references are, leaves spanned
 // 24-26% more packs than they needed on bvh-sah's trees of 2CylinderEngine and yxa_1, leaves of
@@ -44,8 +44,8 @@ bool test_range(const TriPack<4>* packs, std::uint32_t first, std::uint32_t coun
 
 /// Every leaf's references as lanes of packs, or none when some reference is not a triangle.
 struct LeafPacks {
-    /// Each pack (192 bytes with padding) starts a line: a test of it reads three lines, not
-    /// four every other pack.
+    /// The array starts a line, so a pack (160 bytes) starts a line or half a line in: a test of
+    /// it reads three lines, never four.
     std::vector<TriPack<4>, LineAllocator<TriPack<4>>> packs;
 
     LeafPacks() = default;
@@ -75,7 +75,6 @@ struct LeafPacks {
                 for (int i = 0; i < 3; ++i)
                     for (int a = 0; a < 3; ++a) q.v[3 * i + a][l] = v[i][a];
                 q.id[l] = p.id;
-                q.kind[l] = p.kind;
             }
             next += count;
         }
@@ -89,7 +88,7 @@ struct LeafPacks {
         LeafPrim p;
         p.tri = Triangle{{q.v[0][l], q.v[1][l], q.v[2][l]}, {q.v[3][l], q.v[4][l], q.v[5][l]}, {q.v[6][l], q.v[7][l], q.v[8][l]}};
         p.id = q.id[l];
-        p.kind = q.kind[l];
+        p.kind = PrimKind::Triangle;
         return p;
     }
     std::uint32_t id(std::uint32_t k) const { return packs[k / 4].id[k % 4]; }

@@ -8,12 +8,13 @@
 namespace rtcost {
 
 /// Places the array's first element `Lead` elements before a cache line starts: with `Lead` 0,
-/// every element of a multiple of 64 bytes starts a line (bvh's leaf packs); with `Lead` 1 and
+/// every element of a multiple of 32 bytes starts a line or half a line in, and so spans no more
+/// lines than its size rounded up to a line (bvh's leaf packs, 160 bytes: three); with `Lead` 1 and
 /// 32-byte elements, each pair from an odd index shares one line (a binary BVH's sibling nodes,
 /// laid out as the root, then pairs).
 template <class T, std::size_t Lead = 0>
 struct LineAllocator {
-    static_assert(sizeof(T) % 64 == 0 || 64 % sizeof(T) == 0, "elements tile cache lines");
+    static_assert(sizeof(T) % 32 == 0 || 64 % sizeof(T) == 0, "elements tile cache lines or half lines");
     static constexpr std::size_t kLeadBytes = Lead * sizeof(T);
     using value_type = T;
     template <class U>
