@@ -137,6 +137,8 @@ TEST(RaySample, FileRoundTripsAndBadFilesAreRefused) {
     EXPECT_EQ(b.seed, a.seed);
     EXPECT_EQ(a.scene, s.fingerprint());
     EXPECT_EQ(b.scene, a.scene);
+    EXPECT_EQ(a.file_version, 0u);
+    EXPECT_EQ(b.file_version, 3u);
     ASSERT_EQ(b.crossings.size(), a.crossings.size());
     for (std::size_t i = 0; i < a.size(); ++i) {
         EXPECT_EQ(b.rays.rays[i].d, a.rays.rays[i].d);
@@ -153,10 +155,18 @@ TEST(RaySample, FileRoundTripsAndBadFilesAreRefused) {
         std::ifstream in(path, std::ios::binary);
         bytes.assign(std::istreambuf_iterator<char>(in), {});
     }
-    // A version-1 file (no scene fingerprint after the counts) is read, its scene unknown.
+    // A version-1 file (no scene fingerprint after the counts) is read, its scene unknown; a
+    // version-2 file (version 3's layout) is read alike; version 4 is refused.
     {
+        std::string v2 = bytes;
+        ASSERT_EQ(v2[8], 3);
+        v2[8] = 2;
+        std::ofstream(path, std::ios::binary).write(v2.data(), static_cast<std::streamsize>(v2.size()));
+        const RaySample d = read_sample(path);
+        EXPECT_EQ(d.file_version, 2u);
+        EXPECT_EQ(d.scene, a.scene);
+        EXPECT_EQ(d.crossings.size(), a.crossings.size());
         std::string v1 = bytes;
-        ASSERT_EQ(v1[8], 2);
         v1[8] = 1;
         v1.erase(8 + 4 + 4 + 4 * 8, 8);
         std::ofstream(path, std::ios::binary).write(v1.data(), static_cast<std::streamsize>(v1.size()));
@@ -164,9 +174,9 @@ TEST(RaySample, FileRoundTripsAndBadFilesAreRefused) {
         EXPECT_EQ(c.scene, 0u);
         ASSERT_EQ(c.size(), a.size());
         EXPECT_EQ(c.crossings.size(), a.crossings.size());
-        std::string v3 = bytes;
-        v3[8] = 3;
-        std::ofstream(path, std::ios::binary).write(v3.data(), static_cast<std::streamsize>(v3.size()));
+        std::string v4 = bytes;
+        v4[8] = 4;
+        std::ofstream(path, std::ios::binary).write(v4.data(), static_cast<std::streamsize>(v4.size()));
         EXPECT_THROW(read_sample(path), InputError);
     }
     // Truncated, and not a sample at all.
@@ -205,8 +215,29 @@ TEST(RaySample, AFileDrawnOnAnotherSceneIsRefusedByEval) {
     } catch (const InputError& e) {
         EXPECT_NE(std::string(e.what()).find("drawn on another scene"), std::string::npos) << e.what();
         EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+        EXPECT_EQ(std::string(e.what()).find("version-2"), std::string::npos) << e.what();
     }
     EXPECT_EQ(evaluate(balls, spec, opt).rows.size(), 1u);
+    // The same file as version 2 (written before three-vertex NFF polygons became triangles):
+    // its own scene still takes it; another is refused with that possible cause named.
+    {
+        std::string bytes;
+        {
+            std::ifstream in(path, std::ios::binary);
+            bytes.assign(std::istreambuf_iterator<char>(in), {});
+        }
+        ASSERT_EQ(bytes[8], 3);
+        bytes[8] = 2;
+        std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
+    }
+    EXPECT_EQ(evaluate(balls, spec, opt).rows.size(), 1u);
+    try {
+        evaluate(tetra, spec, opt);
+        ADD_FAILURE() << "a version-2 sample of another scene was accepted";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("drawn on another scene"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find("version-2 sample file): draw it again"), std::string::npos) << e.what();
+    }
     std::filesystem::remove(path);
 }
 

@@ -31,6 +31,8 @@ struct RaySample {
     /// Scene::fingerprint() of the scene it was drawn on (set by find_ends); 0: unknown (a
     /// version-1 sample file).
     std::uint64_t scene = 0;
+    /// The version of the sample file it was read from; 0: drawn, not read.
+    std::uint32_t file_version = 0;
 
     std::size_t size() const { return rays.rays.size(); }
     std::span<const Crossing> crossings_of(std::size_t i) const {

@@ -15,7 +15,10 @@ namespace {
 
 constexpr char kMagic[8] = {'R', 'T', 'C', 'S', 'A', 'M', 'P', 'L'};
 // Version 2 added the scene's fingerprint after the counts; version 1 files are still read.
-constexpr std::uint32_t kVersion = 2;
+// Version 3 has version 2's layout: it marks files written since an NFF polygon of three vertices
+// is stored as a triangle, which changed such a scene's fingerprint (evaluate says so when a
+// version-2 file's fingerprint does not match).
+constexpr std::uint32_t kVersion = 3;
 constexpr std::size_t kHeader = 8 + 4 + 4 + 5 * 8 + 4;  // magic, version, reserved, 4 counts, fingerprint, text length
 constexpr std::size_t kRayRecord = 8 * 4 + 1 + 1 + 2 + 4;
 constexpr std::size_t kCrossingRecord = 8;
@@ -75,8 +78,8 @@ RaySample read_sample(const std::string& path) {
     std::uint32_t version = 0, reserved = 0, text = 0;
     std::uint64_t seed = 0, population = 0, rays = 0, crossings = 0, scene = 0;
     get(version, "header");
-    if (version != 1 && version != kVersion)
-        throw InputError(path, 0, "sample file version " + std::to_string(version) + " (this rtcost reads 1 and 2)");
+    if (version < 1 || version > kVersion)
+        throw InputError(path, 0, "sample file version " + std::to_string(version) + " (this rtcost reads 1 to 3)");
     get(reserved, "header");
     get(seed, "header");
     get(population, "header");
@@ -93,6 +96,7 @@ RaySample read_sample(const std::string& path) {
     s.seed = seed;
     s.population = population;
     s.scene = scene;
+    s.file_version = version;
     s.distribution.assign(b.data() + at, text);
     at += text;
     s.rays.described = s.distribution + " (sample)";

@@ -367,8 +367,11 @@ std::optional<RaySample> take_sample(const Scene& scene, RaySet& test, const Eva
             sample = read_sample(opt.sample_file);
             if (sample->scene != 0 && sample->scene != scene.fingerprint())
                 throw InputError(opt.sample_file, 0,
-                                 "the sample was drawn on another scene (its primitives differ from " + scene.name +
-                                     "'s)");
+                                 "the sample was drawn on another scene (its primitives differ from " + scene.name + "'s)" +
+                                     (sample->file_version == 2
+                                          ? ", or before rtcost stored an NFF polygon of three vertices as a triangle "
+                                            "(a version-2 sample file): draw it again with rtcost sample"
+                                          : ""));
             if (sample->distribution != test.described || sample->population != test.rays.size())
                 throw InputError(opt.sample_file, 0,
                                  "the sample was drawn from '" + sample->distribution + "' (" +
