@@ -150,11 +150,7 @@ TEST(RaySample, FileRoundTripsAndBadFilesAreRefused) {
         EXPECT_EQ(b.crossings[i].prim, a.crossings[i].prim);
         EXPECT_EQ(b.crossings[i].t, a.crossings[i].t);
     }
-    std::string bytes;
-    {
-        std::ifstream in(path, std::ios::binary);
-        bytes.assign(std::istreambuf_iterator<char>(in), {});
-    }
+    const std::string bytes = slurp(path);
     // A version-1 file (no scene fingerprint after the counts) is read, its scene unknown; a
     // version-2 file (version 3's layout) is read alike; version 4 is refused.
     {
@@ -221,11 +217,7 @@ TEST(RaySample, AFileDrawnOnAnotherSceneIsRefusedByEval) {
     // The same file as version 2 (written before three-vertex NFF polygons became triangles):
     // its own scene still takes it; another is refused with that possible cause named.
     {
-        std::string bytes;
-        {
-            std::ifstream in(path, std::ios::binary);
-            bytes.assign(std::istreambuf_iterator<char>(in), {});
-        }
+        std::string bytes = slurp(path);
         ASSERT_EQ(bytes[8], 3);
         bytes[8] = 2;
         std::ofstream(path, std::ios::binary).write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
