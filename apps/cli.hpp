@@ -63,9 +63,12 @@ CLI::Validator positive_number();
 /// --camera and --light into `view`.
 void add_view_args(CLI::App* cmd, ViewSpec& view);
 
-/// Refuses, before any long work, an output path that is a directory or lies in a directory
-/// that does not exist (InputError naming the path). `-` is standard output.
-void check_output_path(const std::string& path, const std::string& what);
+/// Refuses, before any long work, an output path (option `what`) that is empty, a directory,
+/// in a directory that does not exist, or the same file as one of `inputs` (the command's input
+/// files, which writing would destroy): InputError naming the path. `-` is standard output: the
+/// command's summary then goes to stderr (nowhere when quiet), so that only data reaches it.
+void check_output_path(const std::string& path, const std::string& what, const Common& common,
+                       const std::vector<std::string>& inputs);
 
 /// --threads clamped to the threads the machine runs at once (a warning on stderr when it is
 /// clamped, unless quiet); 0 stays 0 (all cores).

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <fcntl.h>
 #include <unistd.h>
 
 namespace rtcost::cli {
@@ -140,15 +141,31 @@ std::unique_ptr<Hierarchy> build(const Scene& scene, const BuildArgs& a, const C
 
 namespace rtcost::cli {
 
-void check_output_path(const std::string& path, const std::string& what) {
+void check_output_path(const std::string& path, const std::string& what, const Common& common,
+                       const std::vector<std::string>& inputs) {
     namespace fs = std::filesystem;
     if (path.empty()) throw InputError(what, 0, "empty output path");
-    if (path == "-") return;
+    if (path == "-") {
+        // The data keeps standard output's descriptor; what the command prints goes elsewhere.
+        std::fflush(stdout);
+        const int data = ::dup(STDOUT_FILENO);
+        const int summary = common.quiet ? ::open("/dev/null", O_WRONLY) : STDERR_FILENO;
+        if (data < 0 || summary < 0 || ::dup2(summary, STDOUT_FILENO) < 0)
+            throw InputError(what, 0, "cannot keep standard output for the data");
+        set_standard_output_descriptor(data);
+        return;
+    }
     std::error_code ec;
     if (fs::is_directory(path, ec)) throw InputError(path, 0, "is a directory; give a file name for the output");
     fs::path parent = fs::path(path).parent_path();
     if (!parent.empty() && !fs::is_directory(parent, ec))
         throw InputError(path, 0, fmt::format("directory '{}' does not exist", parent.string()));
+    for (const std::string& in : inputs) {
+        if (in.empty() || in == "-") continue;
+        std::error_code e1;
+        if (fs::exists(path, e1) && fs::exists(in, e1) && fs::equivalent(path, in, e1))
+            throw InputError(path, 0, fmt::format("is the same file as the input {}: writing it would destroy the input", in));
+    }
 }
 
 int checked_threads(int requested, bool quiet) {

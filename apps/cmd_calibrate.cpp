@@ -49,7 +49,12 @@ TimeTerms parse_terms(const std::string& text) {
 
 int cmd_calibrate(const CalibrateArgs& a, const Common& common) {
     const std::vector<HierarchyRequest> names = parse_hierarchy_list(a.hierarchies, 0);
-    check_output_path(a.out, "--out");
+    {
+        std::vector<std::string> inputs = a.scenes;
+        inputs.push_back(a.rays.name);
+        inputs.insert(inputs.end(), a.held_out.begin(), a.held_out.end());
+        check_output_path(a.out, "--out", common, inputs);
+    }
     const TimeTerms terms = parse_terms(a.terms);
     std::vector<CalibrationSample> samples, held;
     std::vector<std::string> held_scene;

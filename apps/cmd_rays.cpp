@@ -14,11 +14,12 @@ struct RaysArgs {
     std::string scene;
     RaySpec spec;
     std::string out;
+    bool out_given = false;  ///< -o given (an empty path is refused, not taken for none)
     int threads = 0;
 };
 
 int cmd_rays(const RaysArgs& a, const Common& common) {
-    if (!a.out.empty()) check_output_path(a.out, "--out");
+    if (a.out_given) check_output_path(a.out, "--out", common, {a.scene, a.spec.name});
     Scene scene = load(a.scene, common, a.spec.view);
     auto start = std::chrono::steady_clock::now();
     RaySet set;
@@ -71,7 +72,8 @@ Subcommand setup_rays(CLI::App& parent, Common& common) {
     for (const auto& n : distribution_names()) names += (names.empty() ? "" : ", ") + n;
     cmd->add_option("-r,--rays,-d,--dist", a->spec.name, "distribution (" + names + ") or a ray file")
         ->capture_default_str();
-    cmd->add_option("-o,--out", a->out, "write the rays here (8 float32 per ray); without it, only the counts");
+    cmd->add_option("-o,--out", a->out, "write the rays here (8 float32 per ray); without it, only the counts")
+        ->each([a](const std::string&) { a->out_given = true; });
     cmd->add_option("--size", a->spec.size,
                     "image size WxH (spd: 512x512, eye rays through its (W+1)x(H+1) corners; others: the scene's)");
     cmd->add_option("--count", a->spec.count, "number of rays for lines and random")

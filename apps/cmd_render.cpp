@@ -100,12 +100,10 @@ int cmd_heatmap(const RenderArgs& a, const Common& common, const Scene& scene, c
 }
 
 int cmd_render(const RenderArgs& a, const Common& common) {
-    check_output_path(a.out, "--out");
+    check_output_path(a.out, "--out", common, {a.b.scene, a.costs});
     Scene scene = load(a.b.scene, common, a.view);
     RenderOptions opt;
-    opt.width = scene.camera.width;
-    opt.height = scene.camera.height;
-    if (!a.size.empty()) parse_size(a.size, "--size", opt.width, opt.height);
+    image_size(scene, a.size, opt.width, opt.height);
     opt.max_depth = a.depth;
     opt.threads = checked_threads(a.threads, common.quiet || common.json);
     auto h = build(scene, a.b, common);

@@ -1,5 +1,6 @@
 // `rtcost report`: the evaluation, the scene's render and every hierarchy's heat map as one
 // self-contained HTML page (and, with --json, the data behind it).
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 
@@ -63,16 +64,31 @@ json run_design(const ReportArgs& a, const Scene& scene, const Common& common) {
     return to_json(r);
 }
 
-json read_eval(const std::string& path) {
+/// An `rtcost eval --json` document of `scene`'s primitives (InputError otherwise).
+json read_eval(const std::string& path, const Scene& scene) {
+    std::error_code ec;
+    if (std::filesystem::is_directory(path, ec)) throw InputError(path, 0, "is a directory, not a file");
     std::ifstream in(path);
     if (!in) throw InputError(path, 0, "no such file");
     json j = json::parse(in, nullptr, false);
     if (j.is_discarded() || !j.is_object() || !j.contains("results") || !j["results"].is_array())
         throw InputError(path, 0, "not an `rtcost eval --json` document");
+    for (const json& r : j["results"])
+        if (!r.is_object() || !r.contains("hierarchy") || !r["hierarchy"].is_string())
+            throw InputError(path, 0, "not an `rtcost eval --json` document: a result without its hierarchy");
+    // Heat maps and the render are made on SCENE: an evaluation of another scene would be
+    // reported as this one's.
+    if (j.contains("primitives") && j["primitives"].is_number_unsigned() &&
+        j["primitives"].get<std::uint64_t>() != scene.size())
+        throw InputError(path, 0,
+                         fmt::format("an evaluation of {} ({} primitives), not of {} ({} primitives)",
+                                     j.value("scene", std::string("another scene")), j["primitives"].get<std::uint64_t>(),
+                                     scene.name, scene.size()));
     return j;
 }
 
 int cmd_report(const ReportArgs& a, const Common& common) {
+    check_output_path(a.out, "--out", common, {a.scene, a.costs, a.from_eval, a.rays.name});
     Scene scene = load(a.scene, common);
     const UnitCosts costs = a.costs.empty() ? UnitCosts{} : UnitCosts::read(a.costs);
     const HeatKind kind = parse_heat_kind(a.heatmap);
@@ -88,7 +104,7 @@ int cmd_report(const ReportArgs& a, const Common& common) {
 
     ReportInput in;
     in.meta = report_meta();
-    in.eval = a.from_eval.empty() ? run_eval(a, scene, costs, common) : read_eval(a.from_eval);
+    in.eval = a.from_eval.empty() ? run_eval(a, scene, costs, common) : read_eval(a.from_eval, scene);
     std::vector<std::string> labels;
     for (const json& r : in.eval["results"]) labels.push_back(r.value("hierarchy", ""));
     {
@@ -137,7 +153,15 @@ Subcommand setup_report(CLI::App& parent, Common& common) {
     cmd->add_option("-o,--out", a->out, "HTML file to write")->capture_default_str();
     add_common(cmd, common);
     cmd->footer(hierarchy_help());
-    return {cmd, [a, &common] { return cmd_report(*a, common); }};
+    return {cmd, [a, &common] {
+                if (a->from_eval.empty()) return cmd_report(*a, common);
+                // A hand-made or edited evaluation whose fields have other types than eval writes.
+                try {
+                    return cmd_report(*a, common);
+                } catch (const nlohmann::json::exception& e) {
+                    throw InputError(a->from_eval, 0, std::string("not an `rtcost eval --json` document: ") + e.what());
+                }
+            }};
 }
 
 const CommandRegistration reg{65, setup_report};

@@ -19,6 +19,7 @@ struct SampleArgs {
 };
 
 int cmd_sample(SampleArgs& a, const Common& common) {
+    check_output_path(a.out, "--out", common, {a.scene, a.rays.name});
     Scene scene = load(a.scene, common, a.rays.view);
     if (a.count == 0) throw InputError("--count", 0, "a sample needs at least one ray");
     // Any exact hierarchy finds the same ends; the SAH BVH is quick to build and to trace.

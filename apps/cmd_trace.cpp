@@ -14,12 +14,13 @@ struct TraceArgs {
     std::string query = "closest";
     std::string shadow = "any";
     std::string hits_out;
+    bool hits_given = false;  ///< --hits given (an empty path is refused, not taken for none)
     int threads = 0;
     bool no_count = false;
 };
 
 int cmd_trace(const TraceArgs& a, const Common& common) {
-    if (!a.hits_out.empty()) check_output_path(a.hits_out, "--hits");
+    if (a.hits_given) check_output_path(a.hits_out, "--hits", common, {a.b.scene, a.rays.name});
     Scene scene = load(a.b.scene, common, a.rays.view);
     RaySet rays = make_rays(scene, a.rays);
     print_warnings(rays.warnings, common.quiet || common.json);
@@ -118,7 +119,8 @@ Subcommand setup_trace(CLI::App& parent, Common& common) {
     cmd->add_option("--shadow", a->shadow, "query for shadow and ambient-occlusion rays: any or closest")
         ->check(CLI::IsMember({"closest", "any"}))
         ->capture_default_str();
-    cmd->add_option("--hits", a->hits_out, "write hits (int32 id, float32 t per ray) to this file");
+    cmd->add_option("--hits", a->hits_out, "write hits (int32 id, float32 t per ray) to this file")
+        ->each([a](const std::string&) { a->hits_given = true; });
     cmd->add_option("-j,--threads", a->threads, "threads (0: all cores)")->check(CLI::Range(0, 1024))->capture_default_str();
     cmd->add_flag("--no-count", a->no_count, "skip the counting pass (timing only)");
     add_common(cmd, common);

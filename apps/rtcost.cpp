@@ -43,9 +43,21 @@ int main(int argc, char** argv) {
         return kExitBadInput;
     }
 
+    // An output being written when Ctrl-C or a kill ends the run is removed, not left half-written.
+    remove_output_on_signals();
     try {
         for (const Subcommand& c : commands)
-            if (*c.app) return c.run();
+            if (*c.app) {
+                const int status = c.run();
+                // What the command printed must have reached standard output (a full disk, a
+                // closed pipe): a summary or JSON cut short is an error, not a success.
+                std::cout.flush();
+                if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+                    fmt::print(stderr, "rtcost: error: standard output: write failed\n");
+                    return kExitBadInput;
+                }
+                return status;
+            }
     } catch (const InputError& e) {
         fmt::print(stderr, "rtcost: error: {}\n", e.what());
         return kExitBadInput;

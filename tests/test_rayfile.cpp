@@ -68,9 +68,16 @@ TEST(RayFile, BadFilesAreRejected) {
     EXPECT_THROW(read_rays("/no/such/file.rays"), InputError);
 }
 
-TEST(RayFile, EmptyFileHasNoRays) {
+TEST(RayFile, EmptyFileIsRefused) {
+    // Nothing to trace is bad input, as an empty scene is: named, not taken for zero rays.
     std::ofstream(tmp("e"), std::ios::binary);
-    EXPECT_TRUE(read_rays(tmp("e").string()).empty());
+    try {
+        read_rays(tmp("e").string());
+        FAIL() << "an empty ray file was read";
+    } catch (const InputError& e) {
+        EXPECT_NE(std::string(e.what()).find("empty: no rays in it"), std::string::npos) << e.what();
+        EXPECT_NE(std::string(e.what()).find(tmp("e").string()), std::string::npos) << e.what();
+    }
 }
 
 TEST(AtomicWrite, FailureLeavesNothingBehind) {

@@ -66,4 +66,13 @@ std::vector<Hit> read_hits(const std::string& path);
 /// link is followed to the file it names, and a directory is refused. Throws InputError.
 void write_file_atomic(const std::string& path, std::string_view bytes);
 
+/// The descriptor `-` is written to by write_file_atomic (standard output's unless a program
+/// moved standard output elsewhere and kept its data descriptor, as the CLI does so that a
+/// summary never mixes with data written onto `-`).
+void set_standard_output_descriptor(int fd);
+
+/// Installs handlers for SIGINT, SIGTERM, SIGHUP and SIGPIPE that remove the temporary file
+/// write_file_atomic is writing, if any, then end the process as the signal would have.
+void remove_output_on_signals();
+
 }  // namespace rtcost

@@ -186,4 +186,8 @@ void check_pixel_subset(const std::vector<std::uint32_t>* only, std::size_t imag
 /// Parses "WxH" (e.g. "512x512") with W*H <= kMaxRays; throws InputError naming `what` otherwise.
 void parse_size(const std::string& text, const std::string& what, int& width, int& height);
 
+/// The image size of camera-based rays: `size` parsed as --size where given, else the scene's
+/// own resolution, refused (InputError naming the scene) beyond kMaxRays pixels.
+void image_size(const Scene& scene, const std::string& size, int& width, int& height);
+
 }  // namespace rtcost

@@ -26,8 +26,11 @@ constexpr Family kFamilies[] = {
 std::vector<std::string> design_set(const DesignOptions& opt, const Scene& scene) {
     std::vector<std::string> set{"rays=" + opt.rays.name, "sample=" + std::to_string(opt.sample),
                                  "seed=" + std::to_string(opt.seed)};
-    set.push_back("size=" + (opt.rays.size.empty() ? fmt::format("{}x{}", scene.camera.width, scene.camera.height)
-                                                    : opt.rays.size));
+    // Without --size, the size the distribution itself takes: spd's 512x512, else the scene's.
+    set.push_back("size=" + (!opt.rays.size.empty() ? opt.rays.size
+                             : opt.rays.name == "spd"
+                                 ? std::string("512x512")
+                                 : fmt::format("{}x{}", scene.camera.width, scene.camera.height)));
     if (!opt.costs_file.empty()) set.push_back("costs=" + opt.costs_file);
     return set;
 }

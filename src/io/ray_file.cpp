@@ -1,5 +1,5 @@
 // Binary ray and hit files (see docs: 8 little-endian float32 per ray; int32 id + float32 t per
-// hit) and atomic output. The formats are fixed-size records, so no serialisation library is
+// hit). The formats are fixed-size records, so no serialisation library is
 // needed; the code assumes a little-endian host, which it checks at compile time.
 #include <algorithm>
 #include <bit>
@@ -33,22 +33,12 @@ std::string read_all(const std::string& path) {
     return bytes;
 }
 
-/// Writes to an existing non-regular file (device, pipe, stdout) without replacing it.
-void write_in_place(const std::string& path, const std::string& target, std::string_view bytes) {
-    std::FILE* f = std::fopen(target.c_str(), "wb");
-    if (!f) throw InputError(path, 0, "cannot open for writing (" + std::string(std::strerror(errno)) + ")");
-    const std::size_t put = std::fwrite(bytes.data(), 1, bytes.size(), f);
-    const bool ok = put == bytes.size() && std::fflush(f) == 0;
-    const int err = errno;
-    std::fclose(f);
-    if (!ok) throw InputError(path, 0, "write failed (" + std::string(std::strerror(err)) + ")");
-}
-
 }  // namespace
 
 std::vector<Ray> read_rays(const std::string& path) {
     std::string bytes = read_all(path);
     constexpr std::size_t kRecord = 8 * sizeof(float);
+    if (bytes.empty()) throw InputError(path, 0, "empty: no rays in it");
     if (bytes.size() % kRecord != 0) {
         throw InputError(path, 0,
                          "size " + std::to_string(bytes.size()) +
@@ -89,40 +79,6 @@ std::string ray_problem(const Ray& r) {
                            "float's range; scale the direction)",
                            dm, kMinDirection, kMaxDirection);
     return {};
-}
-
-void write_file_atomic(const std::string& path, std::string_view bytes) {
-    namespace fs = std::filesystem;
-    std::error_code ec;
-    if (path.empty()) throw InputError("output", 0, "empty output path");
-    // `-` is standard output, written in place.
-    if (path == "-") return write_in_place(path, "/dev/stdout", bytes);
-    // Through a symbolic link: the file it points to is what the user named.
-    fs::path target = fs::weakly_canonical(fs::path(path), ec);
-    if (ec) target = fs::path(path);
-    const fs::file_status st = fs::status(target, ec);
-    if (fs::is_directory(st)) throw InputError(path, 0, "is a directory; give a file name for the output");
-    // A device, a pipe or a socket is written in place: renaming over it would replace it.
-    if (fs::exists(st) && !fs::is_regular_file(st)) return write_in_place(path, target.string(), bytes);
-    fs::path tmp = target;
-    tmp += ".tmp." + std::to_string(::getpid());
-    {
-        std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
-        if (!out) throw InputError(path, 0, "cannot open for writing (" + std::string(std::strerror(errno)) + ")");
-        out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
-        out.flush();
-        if (!out) {
-            out.close();
-            fs::remove(tmp, ec);
-            throw InputError(path, 0, "write failed (disk full?)");
-        }
-    }
-    fs::rename(tmp, target, ec);
-    if (ec) {
-        const std::string why = ec.message();
-        fs::remove(tmp, ec);
-        throw InputError(path, 0, "cannot move output into place: " + why);
-    }
 }
 
 void write_rays(const std::string& path, std::span<const Ray> rays) {

@@ -12,6 +12,7 @@
 #include <unistd.h>
 
 #include "rtcost/error.hpp"
+#include "rtcost/io.hpp"
 #include "rtcost/model.hpp"
 
 namespace rtcost {
@@ -295,15 +296,7 @@ void write_costs(const std::string& path, const Calibration& c, std::span<const 
                         {"polygon_edge", c.costs.polygon_edge},
                         {"rms_relative_residual", c.rms_relative},
                         {"runs", fits}};
-    // Written beside the target and renamed, so a failure leaves no half-written file.
-    std::string tmp = path + ".tmp";
-    {
-        std::ofstream out(tmp);
-        if (!out) throw InputError(path, 0, "cannot write");
-        out << j.dump(2) << "\n";
-        if (!out.flush()) throw InputError(path, 0, "write failed");
-    }
-    std::filesystem::rename(tmp, path);
+    write_file_atomic(path, j.dump(2) + "\n");
 }
 
 }  // namespace rtcost

@@ -2,6 +2,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
 #include "model_internal.hpp"
@@ -110,12 +111,21 @@ UnitCosts UnitCosts::read(const std::string& path) {
     } catch (const nlohmann::json::exception& e) {  // malformed, or a number beyond a double (1e999)
         throw InputError(path, 0, std::string("not a costs file: ") + e.what());
     }
+    if (!j.is_object()) throw InputError(path, 0, "not a costs file: a JSON object of ns per operation expected");
+    if (j.contains("prim") && !j["prim"].is_object())
+        throw InputError(path, 0, "'prim' must be an object of ns per primitive test by kind");
+    if (j.contains("unit") && !j["unit"].is_string()) throw InputError(path, 0, "'unit' must be a string");
     UnitCosts u;
+    int found = 0;
     auto get = [&](const nlohmann::json& obj, const char* key, double& out) {
         if (!obj.contains(key)) return;
-        if (!obj[key].is_number() || !std::isfinite(obj[key].get<double>()) || obj[key].get<double>() < 0)
-            throw InputError(path, 0, std::string("'") + key + "' must be a non-negative number");
+        // Far above any operation's cost (ns or units), far below where sums of them overflow.
+        const double most = std::string_view(key) == "cache_bytes" ? 1e18 : 1e9;
+        if (!obj[key].is_number() || !std::isfinite(obj[key].get<double>()) || obj[key].get<double>() < 0 ||
+            obj[key].get<double>() > most)
+            throw InputError(path, 0, fmt::format("'{}' must be a number from 0 to {:g}", key, most));
         out = obj[key].get<double>();
+        ++found;
     };
     get(j, "box", u.box);
     get(j, "plane", u.plane);
@@ -132,6 +142,7 @@ UnitCosts UnitCosts::read(const std::string& path) {
         for (int k = 0; k < kPrimKinds; ++k)
             get(j["prim"], std::string(prim_kind_name(static_cast<PrimKind>(k))).c_str(), u.prim[k]);
     }
+    if (found == 0) throw InputError(path, 0, "not a costs file: no cost of any operation in it (see rtcost calibrate)");
     u.calibrated = j.value("unit", "") == "ns";
     return u;
 }

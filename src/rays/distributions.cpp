@@ -147,6 +147,17 @@ void parse_size(const std::string& text, const std::string& what, int& width, in
                                               static_cast<std::uint64_t>(width) * height, kMaxRays));
 }
 
+void image_size(const Scene& scene, const std::string& size, int& width, int& height) {
+    if (!size.empty()) return parse_size(size, "--size", width, height);
+    width = scene.camera.width;
+    height = scene.camera.height;
+    const std::uint64_t n = static_cast<std::uint64_t>(width) * static_cast<std::uint64_t>(height);
+    if (n > kMaxRays)
+        throw InputError(scene.name, 0,
+                         fmt::format("its resolution {}x{} is {} rays, beyond the {} rtcost traces: give --size", width,
+                                     height, n, kMaxRays));
+}
+
 namespace {
 const RayDistributionRegistration kCamera{
     {.name = "camera",
@@ -154,8 +165,8 @@ const RayDistributionRegistration kCamera{
      .order = 0,
      .benchmarked = true,
      .make = [](const Scene& scene, const RaySpec& spec, const RayMaking& making) {
-         int w = scene.camera.width, h = scene.camera.height;
-         if (!spec.size.empty()) parse_size(spec.size, "--size", w, h);
+         int w, h;
+         image_size(scene, spec.size, w, h);
          const std::size_t n = static_cast<std::size_t>(w) * h;
          check_pixel_subset(making.only_pixels, n);
          std::vector<Ray> rays;

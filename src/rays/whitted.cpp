@@ -243,8 +243,8 @@ bool is_tree_distribution(const std::string& name) {
 RaySet make_tree_rays(const Scene& scene, const RaySpec& spec, const RayMaking& making) {
     if (!is_tree_distribution(spec.name)) throw InputError(spec.name, 0, "not a ray tree distribution");
     const bool spd = spec.name == "spd";
-    int w = spd ? 512 : scene.camera.width, h = spd ? 512 : scene.camera.height;
-    if (!spec.size.empty()) parse_size(spec.size, "--size", w, h);
+    int w = 512, h = 512;
+    if (!spd || !spec.size.empty()) image_size(scene, spec.size, w, h);
     const std::size_t image_pixels = spd ? static_cast<std::size_t>(w + 1) * (h + 1) : static_cast<std::size_t>(w) * h;
     check_pixel_subset(making.only_pixels, image_pixels);
     // Hits are exact, so the rays are the same whichever hierarchy finds them: use a fast one.

@@ -79,9 +79,22 @@ std::vector<double> ticks_of(const Scale& s) {
     return t;
 }
 
+// cairo's largest image side: a larger one fails, and its null pixel data must not be written.
+constexpr int kMaxSide = 32767;
+
+// A cairo image of w x h pixels, or InputError where cairo cannot make it.
+Surface image_surface(int w, int h) {
+    Surface s(cairo_image_surface_create(CAIRO_FORMAT_RGB24, w, h));
+    if (cairo_surface_status(s.get()) != CAIRO_STATUS_SUCCESS)
+        throw InputError("heatmap", 0,
+                         fmt::format("cannot draw an image of {}x{} pixels ({})", w, h,
+                                     cairo_status_to_string(cairo_surface_status(s.get()))));
+    return s;
+}
+
 // The values as a cairo image, one pixel each.
 Surface map_surface(const std::vector<double>& values, int width, int height, const Scale& scale) {
-    Surface s(cairo_image_surface_create(CAIRO_FORMAT_RGB24, width, height));
+    Surface s = image_surface(width, height);
     cairo_surface_flush(s.get());
     unsigned char* data = cairo_image_surface_get_data(s.get());
     const int stride = cairo_image_surface_get_stride(s.get());
@@ -113,7 +126,7 @@ Image draw_heatmap(const std::vector<double>& values, int width, int height, con
                                       fmt::format("min {:.4g}  mean {:.4g}  max {:.4g}", sum.min, sum.mean, sum.max)};
     if (sum.clipped)
         lines.push_back(fmt::format("scale top {}: {} pixels above it drawn in its colour", label(top), sum.clipped));
-    Surface probe(cairo_image_surface_create(CAIRO_FORMAT_RGB24, 1, 1));
+    Surface probe = image_surface(1, 1);
     Context pc(cairo_create(probe.get()));
     set_font(pc.get(), kFont);
     double label_w = 0, lines_w = 0;
@@ -123,7 +136,12 @@ Image draw_heatmap(const std::vector<double>& values, int width, int height, con
     const double w = std::ceil(std::max(bar_x + kBarWidth + 6 + label_w, kMargin + lines_w) + kMargin);
     const double h = std::ceil(kMargin + mh + kMargin + kLine * lines.size() + kMargin / 2);
 
-    Surface surf(cairo_image_surface_create(CAIRO_FORMAT_RGB24, static_cast<int>(w), static_cast<int>(h)));
+    if (w > kMaxSide || h > kMaxSide)
+        throw InputError("heatmap", 0,
+                         fmt::format("a heat map of {}x{} pixels is {:.0f}x{:.0f} with its legend, beyond the {} pixels "
+                                     "a side an image can have: choose a smaller size",
+                                     width, height, w, h, kMaxSide));
+    Surface surf = image_surface(static_cast<int>(w), static_cast<int>(h));
     Context cr(cairo_create(surf.get()));
     cairo_set_source_rgb(cr.get(), 1, 1, 1);
     cairo_paint(cr.get());

@@ -105,24 +105,35 @@ std::string num(const json& v, const char* format) {
     return fmt::format(fmt::runtime(format), v.get<double>());
 }
 
+/// `obj[key]`, or null where `obj` is no object or has no such key (an uncounted hierarchy's
+/// `measured`, or a hand-edited evaluation): the table shows "-" there.
+json field(const json& obj, const char* key) {
+    return obj.is_object() && obj.contains(key) ? obj[key] : json();
+}
+
+std::string whole(const json& v) { return v.is_number_integer() ? std::to_string(v.get<long long>()) : "-"; }
+
 std::string eval_table(const json& eval) {
     std::string t = "<table id=\"eval\"><thead><tr><th>hierarchy</th><th>build s</th><th>nodes</th><th>bytes</th>"
                     "<th>predicted</th><th>measured</th><th>error</th><th>Mrays/s</th><th>rank predicted</th>"
                     "<th>rank measured</th></tr></thead><tbody>\n";
     for (const json& r : eval.at("results")) {
-        const json& b = r.at("build");
-        const bool modelled = r.contains("predicted") && !r["predicted"].is_null();
+        const json b = field(r, "build");
+        const bool modelled = field(r, "predicted").is_object();
         t += fmt::format(
             "<tr><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td><td>{}</td>"
             "<td>{}</td></tr>\n",
-            esc(r.value("hierarchy", "?")), num(b.value("seconds", json()), "{:.4f}"),
-            b.value("N_IN", 0ull) + b.value("N_V", 0ull), esc(human_bytes(b.value("bytes", 0ull))),
-            modelled ? num(r["predicted"].value("cost", json()), "{:.2f}") : "-",
-            num(r.at("measured").value("cost", json()), "{:.2f}"),
-            modelled ? num(json(100 * r.value("error", 0.0)), "{:+.1f}%") : "-",
-            num(r.value("mrays_per_s", json()), "{:.3f}"),
-            modelled && r.contains("rank_predicted") ? std::to_string(r["rank_predicted"].get<int>()) : "-",
-            r.contains("rank_measured") ? std::to_string(r["rank_measured"].get<int>()) : "-");
+            esc(field(r, "hierarchy").is_string() ? r["hierarchy"].get<std::string>() : "?"),
+            num(field(b, "seconds"), "{:.4f}"),
+            field(b, "N_IN").is_number_unsigned() && field(b, "N_V").is_number_unsigned()
+                ? std::to_string(b["N_IN"].get<std::uint64_t>() + b["N_V"].get<std::uint64_t>())
+                : "-",
+            field(b, "bytes").is_number_unsigned() ? esc(human_bytes(b["bytes"].get<std::uint64_t>())) : "-",
+            modelled ? num(field(r["predicted"], "cost"), "{:.2f}") : "-",
+            num(field(field(r, "measured"), "cost"), "{:.2f}"),
+            modelled && field(r, "error").is_number() ? num(json(100 * r["error"].get<double>()), "{:+.1f}%") : "-",
+            num(field(r, "mrays_per_s"), "{:.3f}"), modelled ? whole(field(r, "rank_predicted")) : "-",
+            whole(field(r, "rank_measured")));
     }
     return t + "</tbody></table>\n";
 }
