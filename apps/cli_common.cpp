@@ -81,8 +81,8 @@ void print_warnings(const std::vector<std::string>& warnings, bool quiet) {
 
 Scene load(const std::string& spec, const Common& common, const ViewSpec& view) {
     Scene scene = load_scene(spec);
+    apply_view(scene, view);  // which may add a warning of its own
     print_warnings(scene.warnings, common.quiet || common.json);
-    apply_view(scene, view);
     return scene;
 }
 

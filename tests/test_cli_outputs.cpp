@@ -163,4 +163,21 @@ TEST(CliOutputs, ASceneResolutionBeyondTheRayLimitNeedsASize) {
     EXPECT_EQ(run_cli("trace " + scene.string() + " -H bvh-sah --size 8x8 -q", 60).code, 0);
 }
 
+TEST(CliOutputs, AFarCameraIsWarnedOfAndOneBeyondTheCoordinateBoundRefused) {
+    // From 1e8 away float cannot resolve a scene of size 1: hits may be rounding noise (as for a
+    // ray file's far origins); beyond 1e12 no coordinate is traced.
+    CliRun far = run_cli("trace builtin:tetra:3 -H bvh-sah --size 4x4 --camera 1e8,-5,0,0,0,0,0,0,1,0.001");
+    EXPECT_EQ(far.code, 0) << far.err;
+    EXPECT_TRUE(has(far.err, "--camera: the camera lies more than 10000 scene sizes away")) << far.err;
+    CliRun near = run_cli("trace builtin:tetra:3 -H bvh-sah --size 4x4 --camera 0,-5,0,0,0,0,0,0,1,40");
+    EXPECT_EQ(near.code, 0);
+    EXPECT_FALSE(has(near.err, "scene sizes away")) << near.err;
+    CliRun beyond = run_cli("trace builtin:tetra:3 -H bvh-sah --size 4x4 --camera 1e13,-5,0,0,0,0,0,0,1,40");
+    EXPECT_EQ(beyond.code, 2);
+    EXPECT_TRUE(has(beyond.err, "rtcost: error: --camera: coordinate 1e+13 beyond +-1e+12")) << beyond.err;
+    CliRun light = run_cli("trace builtin:tetra:3 -H bvh-sah --size 4x4 --rays shadow --light 0,0,1e13");
+    EXPECT_EQ(light.code, 2);
+    EXPECT_TRUE(has(light.err, "rtcost: error: --light: coordinate 1e+13 beyond +-1e+12")) << light.err;
+}
+
 }  // namespace

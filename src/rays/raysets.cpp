@@ -98,6 +98,11 @@ std::vector<float> numbers(const std::string& text, std::size_t n, const std::st
 void apply_view(Scene& scene, const ViewSpec& view) {
     if (!view.camera.empty()) {
         const std::vector<float> v = numbers(view.camera, 10, "--camera");
+        for (int k = 0; k < 6; ++k)  // from and at: as a ray file's origins and a scene's points
+            if (std::fabs(v[k]) > kMaxCoordinate)
+                throw InputError("--camera", 0,
+                                 fmt::format("coordinate {:g} beyond +-{:g}, the largest rtcost traces exactly", v[k],
+                                             kMaxCoordinate));
         Camera c = scene.camera;
         c.from = {v[0], v[1], v[2]};
         c.at = {v[3], v[4], v[5]};
@@ -110,10 +115,19 @@ void apply_view(Scene& scene, const ViewSpec& view) {
         scene.camera = c;
         scene.has_camera = true;
     }
+    // As for a ray file's far origins: the eye rays may start where float cannot resolve the scene.
+    if (scene.has_camera && starts_too_far(scene.bounds(), Ray{scene.camera.from, {1, 0, 0}, 0, kInf}))
+        scene.warnings.push_back(fmt::format(
+            "{}: the camera lies more than {:g} scene sizes away; float positions cannot resolve the scene there, so "
+            "hits may be rounding noise and hierarchies may disagree with brute force",
+            view.camera.empty() ? scene.name : "--camera", kMaxResolvedDistance));
     if (!view.lights.empty()) {
         std::vector<Light> lights;
         for (const std::string& l : view.lights) {
             const std::vector<float> v = numbers(l, 3, "--light");
+            for (float x : v)
+                if (std::fabs(x) > kMaxCoordinate)
+                    throw InputError("--light", 0, fmt::format("coordinate {:g} beyond +-{:g}", x, kMaxCoordinate));
             lights.push_back({{v[0], v[1], v[2]}, {1, 1, 1}});
         }
         scene.lights = std::move(lights);
