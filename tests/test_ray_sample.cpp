@@ -182,6 +182,25 @@ TEST(RaySample, FileRoundTripsAndBadFilesAreRefused) {
     }
     std::ofstream(path, std::ios::binary) << "not a sample file at all, just text";
     EXPECT_THROW(read_sample(path), InputError);
+    // A ray with a negative tmin (refused in a ray file too), and a negative crossing.
+    auto refused = [&](std::string edited, const std::string& words) {
+        std::ofstream(path, std::ios::binary).write(edited.data(), static_cast<std::streamsize>(edited.size()));
+        try {
+            read_sample(path);
+            ADD_FAILURE() << "read: " << words;
+        } catch (const InputError& e) {
+            EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+        }
+    };
+    const std::size_t first_ray = 8 + 4 + 4 + 5 * 8 + 4 + a.distribution.size();
+    const float minus_one = -1;
+    std::string tmin = bytes;
+    std::memcpy(tmin.data() + first_ray + 6 * 4, &minus_one, 4);
+    refused(tmin, "ray 0: tmin -1 is negative");
+    ASSERT_FALSE(a.crossings.empty());
+    std::string crossing = bytes;
+    std::memcpy(crossing.data() + bytes.size() - 4, &minus_one, 4);  // the last crossing's t
+    refused(crossing, "a crossing's t is negative or NaN");
     std::filesystem::remove(path);
 }
 

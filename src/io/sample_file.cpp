@@ -118,9 +118,8 @@ RaySample read_sample(const std::string& path) {
         r.tmin = f[6];
         r.tmax = f[7];
         const std::string where = "ray " + std::to_string(i) + ": ";
-        if (!is_finite(r.o) || !is_finite(r.d) || r.d == Vec3{0, 0, 0} || std::isnan(r.tmin) || std::isnan(r.tmax) ||
-            !(r.tmin <= r.tmax))
-            throw InputError(path, 0, where + "not a valid ray");
+        // The rules of a ray file's records (a negative tmin, a far origin, ...).
+        if (const std::string what = ray_problem(r); !what.empty()) throw InputError(path, 0, where + what);
         if (kind >= kRayKinds || query > 2) throw InputError(path, 0, where + "unknown kind or query");
         if (std::isnan(t_end) || t_end < r.tmin || t_end > r.tmax) throw InputError(path, 0, where + "end outside [tmin, tmax]");
         s.rays.rays.push_back(r);
@@ -136,7 +135,7 @@ RaySample read_sample(const std::string& path) {
     for (Crossing& c : s.crossings) {
         get(c.prim, "crossing");
         get(c.t, "crossing");
-        if (std::isnan(c.t)) throw InputError(path, 0, "a crossing's t is NaN");
+        if (!(c.t >= 0)) throw InputError(path, 0, "a crossing's t is negative or NaN");
     }
     return s;
 }
