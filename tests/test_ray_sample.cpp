@@ -1,6 +1,7 @@
 // The ray sample: it belongs to the scene and the distribution (its ends are brute force's, it
 // is stratified along the distribution, its file round-trips and names the scene it was drawn
 // on), not to any hierarchy.
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <unistd.h>
