@@ -141,6 +141,9 @@ TEST(Reliability, ByteOrderMarkIsSkippedAndLongTokensAreCut) {
     EXPECT_TRUE(contains(e, "long.nff:2: unknown entity")) << e;
     EXPECT_LT(e.size(), 200u);
     EXPECT_TRUE(contains(e, "300000 characters")) << e;
+    // A NUL or a control byte is quoted as \xNN: it neither cuts the message nor reaches the terminal.
+    e = thrown([] { read_nff(std::string("s 0 0 0 1\n\0\x0f" "abc\n", 16), "nul.nff"); });
+    EXPECT_TRUE(contains(e, "nul.nff:2: unknown entity '\\x00\\x0fabc'")) << e;
 }
 
 TEST(Reliability, PlanarQuadsWrittenAsTextLoadWithoutANonPlanarWarning) {

@@ -3,8 +3,10 @@
 /// The one exception type for bad input. Its message always names the file (or source), the
 /// line where there is one, and the problem: "scene.nff:12: sphere radius is NaN".
 
+#include <cstddef>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 namespace rtcost {
 
@@ -24,5 +26,26 @@ private:
     std::string file_;
     int line_;
 };
+
+/// A piece of an input file as a message quotes it: at most 40 bytes (a runaway token can be
+/// megabytes, said with its length), and a byte that is not printable ASCII (a NUL, a control
+/// character, binary junk) as \xNN, so the message reaches the terminal whole and harmless.
+inline std::string shown_token(std::string_view t) {
+    constexpr std::size_t kMax = 40;
+    static constexpr char kHex[] = "0123456789abcdef";
+    std::string out;
+    for (const char c : t.substr(0, kMax)) {
+        const auto b = static_cast<unsigned char>(c);
+        if (b >= 0x20 && b < 0x7f) {
+            out.push_back(c);
+        } else {
+            out += "\\x";
+            out.push_back(kHex[b >> 4]);
+            out.push_back(kHex[b & 15]);
+        }
+    }
+    if (t.size() > kMax) out += "... (" + std::to_string(t.size()) + " characters)";
+    return out;
+}
 
 }  // namespace rtcost

@@ -73,12 +73,7 @@ private:
     int peek_line_end_ = 1;
 };
 
-// A token as error messages show it: at most 40 characters (a runaway token can be megabytes).
-std::string shown(std::string_view t) {
-    constexpr std::size_t kMax = 40;
-    if (t.size() <= kMax) return std::string(t);
-    return fmt::format("{}... ({} characters)", t.substr(0, kMax), t.size());
-}
+std::string shown(std::string_view t) { return shown_token(t); }
 
 bool is_entity(std::string_view t) {
     return t == "v" || t == "b" || t == "l" || t == "f" || t == "c" || t == "s" || t == "p" || t == "pp";

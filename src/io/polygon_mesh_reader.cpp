@@ -80,9 +80,7 @@ bool to_double(std::string_view t, double& v) {
     return ec == std::errc() && p == t.data() + t.size();
 }
 
-std::string shown(std::string_view t) {
-    return t.size() <= 40 ? std::string(t) : std::string(t.substr(0, 40)) + "...";
-}
+std::string shown(std::string_view t) { return shown_token(t); }
 
 /// The vertex index `idx` of face `f`, checked against the vertex count.
 std::uint32_t checked_index(long long idx, long long vertices, auto&& fail, int line, long long f, std::string_view text) {
