@@ -41,6 +41,8 @@ std::vector<Estimator> parse_estimators(const std::string& list) {
         if (e == "geometric") out.push_back(Estimator::Geometric);
         else if (e == "sampled") out.push_back(Estimator::Sampled);
         else if (e == "segments") out.push_back(Estimator::Segments);
+        else if (e == "both" || e == "all")
+            throw InputError("--estimator", 0, "'" + e + "' stands alone, not in a list ('" + list + "')");
         else throw InputError("--estimator", 0, "'" + e + "': geometric, sampled, segments, a list of them, both or all");
     }
     return out;

@@ -82,7 +82,14 @@ int cmd_trace(const TraceArgs& a, const Common& common) {
     fmt::print("scene      {} ({} primitives: {})\n", scene.name, scene.size(), kind_summary(scene));
     fmt::print("hierarchy  {}: built in {:.4f} s, {} interior, {} leaves, depth {}, {}\n", h->name(), s.seconds,
                s.interior, s.leaves, s.depth, human_bytes(s.bytes));
-    fmt::print("rays       {} ({}), {} query, {} hits\n", n_rays, rays.described, a.query, timed.hit_count);
+    // Shadow and ambient-occlusion rays are traced with --shadow's query, the others with --query's.
+    bool has_occlusion = false, has_others = false;
+    for (int k : kinds) (is_occlusion(static_cast<RayKind>(k)) ? has_occlusion : has_others) = true;
+    const std::string queries =
+        has_occlusion && has_others ? fmt::format("{} query ({} for shadow and ao rays)", a.query, a.shadow)
+        : has_occlusion             ? fmt::format("{} query", a.shadow)
+                                    : fmt::format("{} query", a.query);
+    fmt::print("rays       {} ({}), {}, {} hits\n", n_rays, rays.described, queries, timed.hit_count);
     if (kinds.size() > 1) {
         for (int k : kinds)
             fmt::print("           {:<11} {:>9} rays {:>9} hits\n", ray_kind_name(static_cast<RayKind>(k)),
