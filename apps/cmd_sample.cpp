@@ -30,6 +30,11 @@ int cmd_sample(SampleArgs& a, const Common& common) {
     making.tracer = reference.get();
     const RaySample s = draw_sample_from(scene, make_rays(scene, a.rays, making), a.count, a.rays.seed, *reference,
                                          parse_query(a.query), parse_query(a.shadow));
+    if (s.size() < a.count && !common.quiet && !common.json)
+        fmt::print(stderr,
+                   "rtcost: warning: --count {}: a sample of {} rays drawn (the distribution has {}, and a sample "
+                   "leaves test rays)\n",
+                   a.count, s.size(), s.population);
     write_sample(a.out, s);
     std::array<std::size_t, kRayKinds> rays{}, ended{};
     for (std::size_t i = 0; i < s.size(); ++i) {
