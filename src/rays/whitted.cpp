@@ -151,6 +151,26 @@ RayTree join(std::vector<Recorder>& rows, bool record) {
 
 using PixelRng = ItemRng;  // one stream per pixel
 
+/// The rays a distribution's rows record, bounded by kMaxRays as --size bounds an image: a tree
+/// or a scene of many lights spawns many rays per pixel, which would otherwise end in running
+/// out of memory. Checked after each row (rows run in parallel), so the bound is passed by at
+/// most a row per thread before the InputError.
+class RayBudget {
+public:
+    void charge(std::size_t rays) {
+        if (total_.fetch_add(rays) + rays > kMaxRays)
+            throw InputError("--size", 0,
+                             fmt::format("the rays this distribution spawns at this size (with the scene's {} lights) "
+                                         "pass {}, the most rtcost makes: choose a smaller size",
+                                         lights_, kMaxRays));
+    }
+    explicit RayBudget(std::size_t lights) : lights_(lights) {}
+
+private:
+    std::atomic<std::uint64_t> total_{0};
+    std::size_t lights_;
+};
+
 }  // namespace
 
 namespace detail {
@@ -175,6 +195,7 @@ RayTree whitted_tree(const Hierarchy& h, const WhittedOptions& opt) {
     const CameraRay eye(scene.camera, opt.width, opt.height);
     detail::WhittedTracer tracer(h, opt.max_depth, opt.shadow_tests);
     std::vector<Recorder> rows(static_cast<std::size_t>(opt.height));
+    RayBudget budget(scene.lights.size());
     detail::run_rows(
         opt.height, opt.threads,
         [&](int j) {
@@ -184,6 +205,7 @@ RayTree whitted_tree(const Hierarchy& h, const WhittedOptions& opt) {
                 rec.pixel = static_cast<std::uint32_t>(pixel);
                 tracer.trace(eye(pixel), RayKind::Eye, 1, &rec);
             });
+            budget.charge(rec.rays.size());
         },
         opt.progress);
     return join(rows, opt.record);
@@ -197,6 +219,7 @@ RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int 
     detail::WhittedTracer tracer(h, 1);
     const float eps = spawn_offset(scene), ao = ao_length(scene);
     std::vector<Recorder> rows(static_cast<std::size_t>(height));
+    RayBudget budget(scene.lights.size());
     detail::run_rows(
         height, threads,
         [&](int j) {
@@ -231,6 +254,7 @@ RayTree camera_hit_rays(const Hierarchy& h, CameraHitRays which, int width, int 
                     rec.add(r, RayKind::AO, test_spawned && h.any(r, sh));
                 }
             });
+            budget.charge(rec.rays.size());
         },
         progress);
     return join(rows, true);
