@@ -21,7 +21,7 @@ CommandRegistration::CommandRegistration(int order, CommandSetup setup) {
 
 void add_common(CLI::App* cmd, Common& common, bool with_json) {
     if (with_json) cmd->add_flag("--json", common.json, "machine-readable JSON on stdout");
-    cmd->add_flag("-q,--quiet", common.quiet, "no progress and no warnings on stderr");
+    cmd->add_flag("-q,--quiet", common.quiet, "no progress and no warnings on stderr (and no summary where an output is -)");
 }
 
 CLI::Validator whole_number(std::uint64_t lo, std::uint64_t hi) {
@@ -149,9 +149,12 @@ void check_output_path(const std::string& path, const std::string& what, const C
         // The data keeps standard output's descriptor; what the command prints goes elsewhere.
         std::fflush(stdout);
         const int data = ::dup(STDOUT_FILENO);
-        const int summary = common.quiet ? ::open("/dev/null", O_WRONLY) : STDERR_FILENO;
+        // --json is output asked for: to stderr even with --quiet.
+        const bool drop = common.quiet && !common.json;
+        const int summary = drop ? ::open("/dev/null", O_WRONLY) : STDERR_FILENO;
         if (data < 0 || summary < 0 || ::dup2(summary, STDOUT_FILENO) < 0)
             throw InputError(what, 0, "cannot keep standard output for the data");
+        if (drop) ::close(summary);
         set_standard_output_descriptor(data);
         return;
     }
@@ -161,7 +164,8 @@ void check_output_path(const std::string& path, const std::string& what, const C
     if (!parent.empty() && !fs::is_directory(parent, ec))
         throw InputError(path, 0, fmt::format("directory '{}' does not exist", parent.string()));
     for (const std::string& in : inputs) {
-        if (in.empty() || in == "-") continue;
+        // A distribution's name or a built-in scene is not the file of that name.
+        if (in.empty() || in == "-" || in.starts_with("builtin:") || find_ray_distribution(in)) continue;
         std::error_code e1;
         if (fs::exists(path, e1) && fs::exists(in, e1) && fs::equivalent(path, in, e1))
             throw InputError(path, 0, fmt::format("is the same file as the input {}: writing it would destroy the input", in));

@@ -3,6 +3,9 @@
 #include <malloc.h>
 #include <new>
 
+#include <fcntl.h>
+#include <unistd.h>
+
 #include "cli.hpp"
 
 using namespace rtcost;
@@ -43,6 +46,10 @@ int main(int argc, char** argv) {
         return kExitBadInput;
     }
 
+    // Descriptors 0-2 closed by the caller would be reused by the first files opened (and `-o -`
+    // would send its summary into the data): held on /dev/null instead.
+    for (int fd = 0; fd < 3; ++fd)
+        if (::fcntl(fd, F_GETFD) < 0 && ::open("/dev/null", fd == 0 ? O_RDONLY : O_WRONLY) < 0) return 1;
     // An output being written when Ctrl-C or a kill ends the run is removed, not left half-written.
     remove_output_on_signals();
     try {
@@ -65,6 +72,12 @@ int main(int argc, char** argv) {
         fmt::print(stderr, "rtcost: error: out of memory\n");
         return 1;
     } catch (const std::exception& e) {
+        // A printed table or JSON larger than stdio's buffer fails inside fmt::print (a full
+        // disk, a closed pipe): the same error as a short one found at the end.
+        if (std::ferror(stdout)) {
+            fmt::print(stderr, "rtcost: error: standard output: write failed\n");
+            return kExitBadInput;
+        }
         fmt::print(stderr, "rtcost: error: {}\n", e.what());
         return 1;
     }

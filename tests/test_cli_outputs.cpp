@@ -5,11 +5,13 @@
 // scene whose resolution is beyond what rtcost traces).
 #include <gtest/gtest.h>
 
-#include <chrono>
 #include <csignal>
+#include <fcntl.h>
 #include <filesystem>
 #include <fstream>
-#include <thread>
+#include <poll.h>
+#include <sys/stat.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "test_support.hpp"
@@ -93,27 +95,76 @@ TEST(CliOutputs, AFailedWriteOnStandardOutputIsAnError) {
 }
 
 TEST(CliOutputs, AnInterruptedWriteLeavesNoTemporaryFile) {
-    // Eight million rays (256 MB) take a while to write; the process is ended while it writes.
-    const fs::path out = dir() / "big.rays";
-    const std::string cmd = std::string(RTCOST_CLI) + " rays builtin:balls:2 --dist lines --count 8000000 -o " +
-                            out.string() + " -q & echo $! > " + (dir() / "pid").string();
-    ASSERT_EQ(std::system(cmd.c_str()), 0);
-    const pid_t pid = std::stoi(slurp(dir() / "pid"));
-    auto temporary = [&] {
-        for (const auto& e : fs::directory_iterator(dir()))
-            if (e.path().filename().string().starts_with("big.rays.tmp.")) return true;
-        return false;
-    };
-    bool seen = false;
-    for (int i = 0; i < 600 && !seen; ++i) {
-        seen = temporary();
-        if (!seen) std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    // Deterministic: the temporary rtcost will write is made a FIFO first, so its write stalls
+    // once the pipe is full (10,000 rays are 320 KB); a byte read from it says the write has
+    // begun, and the process is then ended. Its handler must remove the temporary.
+    const fs::path out = fs::weakly_canonical(dir() / "stalled.rays");
+    int go[2];
+    ASSERT_EQ(::pipe(go), 0);
+    const pid_t pid = ::fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+        char c;
+        if (::read(go[0], &c, 1) != 1) ::_exit(126);
+        const int null = ::open("/dev/null", O_WRONLY);
+        ::dup2(null, STDOUT_FILENO);
+        ::dup2(null, STDERR_FILENO);
+        ::execl(RTCOST_CLI, RTCOST_CLI, "rays", "builtin:tetra:3", "--dist", "lines", "--count", "10000", "-o",
+                out.c_str(), "-q", static_cast<char*>(nullptr));
+        ::_exit(127);
     }
+    const fs::path tmp = out.string() + ".tmp." + std::to_string(pid);
+    ASSERT_EQ(::mkfifo(tmp.c_str(), 0600), 0);
+    const int fifo = ::open(tmp.c_str(), O_RDONLY | O_NONBLOCK);
+    ASSERT_GE(fifo, 0);
+    ASSERT_EQ(::write(go[1], "x", 1), 1);
+    pollfd p{fifo, POLLIN, 0};
+    const bool writing = ::poll(&p, 1, 120000) == 1 && (p.revents & POLLIN);
+    char byte;
+    EXPECT_TRUE(writing && ::read(fifo, &byte, 1) == 1);
     ::kill(pid, SIGTERM);
-    for (int i = 0; i < 200 && ::kill(pid, 0) == 0; ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    if (!seen) GTEST_SKIP() << "the write ended before it could be interrupted";
-    EXPECT_FALSE(temporary());
+    int status = 0;
+    ASSERT_EQ(::waitpid(pid, &status, 0), pid);
+    ::close(fifo);
+    ::close(go[0]);
+    ::close(go[1]);
+    EXPECT_TRUE(WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM) << status;
+    EXPECT_FALSE(fs::exists(tmp));
     EXPECT_FALSE(fs::exists(out));
+    fs::remove(tmp);
+}
+
+TEST(CliOutputs, AnIgnoredSignalStaysIgnored) {
+    // nohup's SIGHUP: the handlers that remove a temporary are not put in its place. The signal
+    // comes half a second in (2 million rays take longer), once main has installed its handlers.
+    const fs::path out = dir() / "hup.rays";
+    const std::string cmd = "bash -c 'trap \"\" HUP; " + std::string(RTCOST_CLI) +
+                            " rays builtin:tetra:3 --dist lines --count 2000000 -o " + out.string() +
+                            " -q > /dev/null & sleep 0.5; kill -HUP $!; wait $!'";
+    const int status = std::system(cmd.c_str());
+    ASSERT_TRUE(WIFEXITED(status));
+    EXPECT_EQ(WEXITSTATUS(status), 0);
+    EXPECT_EQ(fs::file_size(out), 2000000u * 32);
+    fs::remove(out);
+}
+
+TEST(CliOutputs, AnOutputNamedLikeADistributionIsNotTakenForIt) {
+    // `--dist lines -o lines` twice: the distribution's name is not the file of that name.
+    const fs::path d = dir() / "named";
+    fs::create_directories(d);
+    const std::string cmd = "cd " + d.string() + " && " + RTCOST_CLI +
+                            " rays builtin:tetra:3 --dist lines --count 5 -o lines -q > /dev/null 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0);
+    EXPECT_EQ(std::system(cmd.c_str()), 0);
+    EXPECT_EQ(fs::file_size(d / "lines"), 5u * 32);
+}
+
+TEST(CliOutputs, ALongOutputOnAFullDiskIsAnError) {
+    // `list` prints more than stdio's buffer holds, so the write fails inside the command.
+    if (!fs::exists("/dev/full")) GTEST_SKIP() << "no /dev/full here";
+    const int code = std::system((std::string(RTCOST_CLI) + " list > /dev/full 2> /dev/null").c_str());
+    ASSERT_TRUE(WIFEXITED(code));
+    EXPECT_EQ(WEXITSTATUS(code), 2);
 }
 
 TEST(CliOutputs, AHeatMapTooWideToDrawIsRefused) {

@@ -71,8 +71,9 @@ void write_file_atomic(const std::string& path, std::string_view bytes);
 /// summary never mixes with data written onto `-`).
 void set_standard_output_descriptor(int fd);
 
-/// Installs handlers for SIGINT, SIGTERM, SIGHUP and SIGPIPE that remove the temporary file
-/// write_file_atomic is writing, if any, then end the process as the signal would have.
+/// Installs handlers for SIGINT, SIGTERM, SIGHUP and SIGPIPE (those not ignored already) that
+/// remove the temporary file write_file_atomic is writing, if any, then end the process as the
+/// signal would have. One temporary at a time is known: the last write_file_atomic started.
 void remove_output_on_signals();
 
 }  // namespace rtcost

@@ -17,14 +17,21 @@ namespace {
 std::atomic<int> g_stdout_fd{STDOUT_FILENO};
 
 /// The temporary file being written, for the signal handler to remove: a fixed buffer, as a
-/// handler may not allocate. Empty (first byte 0) when none is.
+/// handler may not allocate, published by a lock-free flag (the signal may be handled on another
+/// thread). One slot: a program writes one output at a time (the CLI does; a library user
+/// writing several at once from threads has the last one's temporary removed).
 char g_pending[4096];
-volatile std::sig_atomic_t g_has_pending = 0;
+std::atomic<int> g_has_pending{0};
+static_assert(std::atomic<int>::is_always_lock_free);
 
 extern "C" void remove_pending_and_reraise(int sig) {
-    if (g_has_pending) ::unlink(g_pending);
-    std::signal(sig, SIG_DFL);
-    std::raise(sig);
+    const int saved = errno;
+    if (g_has_pending.load(std::memory_order_acquire)) ::unlink(g_pending);
+    errno = saved;
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    ::sigaction(sig, &dfl, nullptr);
+    ::raise(sig);
 }
 
 /// Registers `tmp` as the file to remove if a signal ends the process while it is written.
@@ -33,11 +40,12 @@ public:
     explicit PendingFile(const std::filesystem::path& tmp) {
         const std::string s = tmp.string();
         if (s.size() < sizeof g_pending) {
+            g_has_pending.store(0, std::memory_order_release);
             std::memcpy(g_pending, s.c_str(), s.size() + 1);
-            g_has_pending = 1;
+            g_has_pending.store(1, std::memory_order_release);
         }
     }
-    ~PendingFile() { g_has_pending = 0; }
+    ~PendingFile() { g_has_pending.store(0, std::memory_order_release); }
     PendingFile(const PendingFile&) = delete;
     PendingFile& operator=(const PendingFile&) = delete;
 };
@@ -69,7 +77,16 @@ void write_in_place(const std::string& path, const std::string& target, std::str
 void set_standard_output_descriptor(int fd) { g_stdout_fd = fd; }
 
 void remove_output_on_signals() {
-    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) std::signal(sig, remove_pending_and_reraise);
+    for (int sig : {SIGINT, SIGTERM, SIGHUP, SIGPIPE}) {
+        // A signal the parent ignores (nohup's SIGHUP, a script's background SIGINT, SIGPIPE)
+        // stays ignored, for this process and what it runs.
+        struct sigaction old {};
+        if (::sigaction(sig, nullptr, &old) != 0 || old.sa_handler == SIG_IGN) continue;
+        struct sigaction act {};
+        act.sa_handler = remove_pending_and_reraise;
+        sigemptyset(&act.sa_mask);
+        ::sigaction(sig, &act, nullptr);
+    }
 }
 
 void write_file_atomic(const std::string& path, std::string_view bytes) {
