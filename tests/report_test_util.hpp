@@ -35,11 +35,7 @@ inline std::array<int, 3> pixel(const Image& img, int i, int j) {
     return {p[0], p[1], p[2]};
 }
 
-inline fs::path temp_dir() {
-    fs::path d = fs::temp_directory_path() / ("rtcost_report_test_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-}
+inline fs::path temp_dir() { return test::temp_dir("report_test"); }
 
 using test::CliRun;
 using test::run_cli;

@@ -22,21 +22,13 @@ using rtcost::test::CliRun;
 using rtcost::test::run_cli;
 using rtcost::test::slurp;
 
-fs::path temp_dir() {
-    fs::path d = fs::temp_directory_path() / ("rtcost_cli_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-}
+fs::path temp_dir() { return rtcost::test::temp_dir("cli"); }
 
 fs::path write(const std::string& name, const std::string& bytes) {
-    fs::path p = temp_dir() / name;
-    std::ofstream(p, std::ios::binary) << bytes;
-    return p;
+    return rtcost::test::write_file(temp_dir() / name, bytes);
 }
 
-const char* kSmallNff =
-    "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.1\nresolution 8 8\n"
-    "l 0 5 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\np 3\n-3 -3 -2\n3 -3 -2\n0 3 -2\n";
+using rtcost::test::kSmallNff;
 
 TEST(Cli, HelpListsSubcommandsAndHierarchyParameters) {
     CliRun r = run_cli("--help");

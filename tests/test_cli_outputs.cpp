@@ -24,23 +24,13 @@ using rtcost::test::CliRun;
 using rtcost::test::run_cli;
 using rtcost::test::slurp;
 
-fs::path dir() {
-    fs::path d = fs::temp_directory_path() / ("rtcost_cli_out_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-}
+fs::path dir() { return rtcost::test::temp_dir("cli_out"); }
 
-fs::path write(const std::string& name, const std::string& bytes) {
-    fs::path p = dir() / name;
-    std::ofstream(p, std::ios::binary) << bytes;
-    return p;
-}
+fs::path write(const std::string& name, const std::string& bytes) { return rtcost::test::write_file(dir() / name, bytes); }
 
 bool has(const std::string& text, const std::string& part) { return text.find(part) != std::string::npos; }
 
-const char* kScene =
-    "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.1\nresolution 8 8\n"
-    "l 0 5 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\np 3\n-3 -3 -2\n3 -3 -2\n0 3 -2\n";
+const char* const kScene = rtcost::test::kSmallNff;
 
 TEST(CliOutputs, DataOntoDashIsAloneOnStandardOutput) {
     // Ten rays are 320 bytes; the summary goes to stderr (nowhere with --quiet).

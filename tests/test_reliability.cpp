@@ -24,13 +24,7 @@ std::string thrown(const std::function<void()>& f) {
 
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
-fs::path scratch() {
-    fs::path d = fs::temp_directory_path() / ("rtcost_rel_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-}
-
-void write_file(const fs::path& p, const std::string& bytes) { std::ofstream(p, std::ios::binary) << bytes; }
+fs::path scratch() { return test::temp_dir("rel"); }
 
 std::string ray_bytes(const std::vector<Ray>& rays) {
     std::string b;

@@ -19,20 +19,12 @@ namespace fs = std::filesystem;
 using CliResult = rtcost::test::CliRun;
 using rtcost::test::slurp;
 
-fs::path dir() {
-    fs::path d = fs::temp_directory_path() / ("rtcost_relcli_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-}
+fs::path dir() { return rtcost::test::temp_dir("relcli"); }
 
 // Runs the binary with a time limit (`timeout` kills a hang, which then fails the test).
 CliResult rtcost(const std::string& args, int seconds = 60) { return rtcost::test::run_cli(args, seconds); }
 
-fs::path file(const std::string& name, const std::string& bytes) {
-    fs::path p = dir() / name;
-    std::ofstream(p, std::ios::binary) << bytes;
-    return p;
-}
+fs::path file(const std::string& name, const std::string& bytes) { return rtcost::test::write_file(dir() / name, bytes); }
 
 bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 

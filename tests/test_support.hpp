@@ -198,6 +198,26 @@ inline std::string slurp(const std::filesystem::path& p) {
     return ss.str();
 }
 
+/// A directory of this test process under the system's temporary directory, `rtcost_<tag>_<pid>`
+/// (made if missing): the tests of one binary share it, binaries running at once do not.
+inline std::filesystem::path temp_dir(const std::string& tag) {
+    std::filesystem::path d = std::filesystem::temp_directory_path() / ("rtcost_" + tag + "_" + std::to_string(::getpid()));
+    std::filesystem::create_directories(d);
+    return d;
+}
+
+/// Writes `bytes` to `p` (replacing it) and returns `p`.
+inline std::filesystem::path write_file(const std::filesystem::path& p, const std::string& bytes) {
+    std::ofstream(p, std::ios::binary) << bytes;
+    return p;
+}
+
+/// A small NFF scene for the command-line tests: a camera of 8x8 pixels, a light, a sphere and a
+/// triangle behind it.
+inline constexpr const char* kSmallNff =
+    "v\nfrom 0 0 5\nat 0 0 0\nup 0 1 0\nangle 40\nhither 0.1\nresolution 8 8\n"
+    "l 0 5 5\nf 1 0 0 1 0 0 0 1\ns 0 0 0 1\np 3\n-3 -3 -2\n3 -3 -2\n0 3 -2\n";
+
 /// How a run of the rtcost binary ended: its exit code (-1: killed), stdout and stderr.
 struct CliRun {
     int code;

@@ -368,11 +368,7 @@ using test::CliRun;
 using test::run_cli;
 using test::slurp;
 
-fs::path temp_dir() {
-    fs::path d = fs::temp_directory_path() / ("rtcost_rayscli_" + std::to_string(::getpid()));
-    fs::create_directories(d);
-    return d;
-}
+fs::path temp_dir() { return test::temp_dir("rayscli"); }
 
 TEST(RaysCli, SpdJsonCountsMatchTheFileAndTheLibrary) {
     RTCOST_REQUIRE_SPD("gears");
