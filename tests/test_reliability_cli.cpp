@@ -45,6 +45,10 @@ TEST(ReliabilityCli, CountSizeAndThreadsAreValidatedClearly) {
     EXPECT_FALSE(has(r.out, "\"threads\": 1000")) << r.out;
     EXPECT_BAD_INPUT(rtcost("eval builtin:tetra:2 -H bvh-sah --rays camera --size 1x1 --estimator sampled"),
                      "training and test rays");
+    // A designed hierarchy's own image size is named as given (it was blamed on --size).
+    r = rtcost("trace builtin:tetra:2 -H bvh-design --set size=0x0 --rays lines --count 5");
+    EXPECT_BAD_INPUT(r, "--set size: '0x0'");
+    EXPECT_FALSE(has(r.err, "--size")) << r.err;
 }
 
 // Every unsigned count and seed of every command: a negative number, one beyond 64 bits and

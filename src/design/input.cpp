@@ -5,6 +5,7 @@
 
 #include "rtcost/design.hpp"
 #include "rtcost/error.hpp"
+#include "rtcost/rays.hpp"
 
 namespace rtcost {
 
@@ -27,6 +28,10 @@ DesignInput draw_design_input(const Scene& scene, const Params& p) {
     DesignInput in;
     in.spec.name = p.str("rays");
     in.spec.size = p.str("size");
+    if (!in.spec.size.empty()) {  // named as the user gave it, not as the command line's --size
+        int width, height;
+        parse_size(in.spec.size, "--set size", width, height);
+    }
     in.spec.seed = 1;
     in.count = static_cast<std::size_t>(p.integer("sample"));
     in.seed = static_cast<std::uint64_t>(p.integer("seed"));
