@@ -280,7 +280,12 @@ def main(argv=None):
         if r["status"] != "ok":
             print(f"rtcost: error: {r['scene']} {r['hierarchy']} {_params(r['params'])}: {r['error']}",
                   file=sys.stderr)
-    return 1 if stats["failed"] else 0
+    # Exit 2 (bad input) when every failed job failed on its input (a scene, a parameter or a
+    # distribution the spec names wrongly), 1 when some job failed otherwise.
+    failed = [r for r in rows if r["status"] != "ok"]
+    if not failed:
+        return 0
+    return 2 if all(r.get("error_type") == "InputError" for r in failed) else 1
 
 
 def _params(params):

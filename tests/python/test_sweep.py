@@ -88,7 +88,7 @@ def test_a_failing_job_is_reported_and_the_others_kept(tmp_path):
     spec_file = tmp_path / "spec.json"
     spec_file.write_text(json.dumps(spec))
     p = run_cli("sweep", spec_file, "--json", check=False)
-    assert p.returncode == 1, p.stderr
+    assert p.returncode == 2, p.stderr  # the only failure is a bad parameter: bad input
     rows = [json.loads(line) for line in p.stdout.splitlines()]
     assert [r["status"] for r in rows] == ["ok", "error", "ok"]
     with pytest.raises(rtcost.InputError) as e:
