@@ -1,6 +1,8 @@
 // Arvo and Kirk's 5D ray classification (`rc5d`): exact structure of a constructed scene, the
 // beam test, lazy against eager (hits and counters), the memory cap, and the counters of a
 // classification path. (Exact hits against brute force: test_rc5d_hits.cpp.)
+#include <unistd.h>
+
 #include "rc5d_test_util.hpp"
 #include "rtcost/error.hpp"
 
@@ -244,6 +246,19 @@ TEST(Rc5dBuild, BadParametersAreClearErrors) {
     EXPECT_EQ(as_rc5d(*h).options().max_depth, 30);
     EXPECT_TRUE(as_rc5d(*h).options().lazy);
     EXPECT_EQ(as_rc5d(*h).options().max_bytes, std::uint64_t{1} << 30);
+    EXPECT_EQ(as_rc5d(*h).options().asked_max_bytes, 0u);
+}
+
+// A memory cap beyond the machine's memory would bound nothing (the build would run out of
+// memory first): it is lowered to half the physical memory, which the limits name if reached.
+TEST(Rc5dBuild, ACapBeyondTheMachinesMemoryIsLowered) {
+    const std::uint64_t half = static_cast<std::uint64_t>(::sysconf(_SC_PHYS_PAGES)) *
+                               static_cast<std::uint64_t>(::sysconf(_SC_PAGESIZE)) / 2;
+    ASSERT_GT(half, 0u);
+    ASSERT_LT(half, std::uint64_t{1} << 36) << "a machine of more than 128 GiB: the test's cap is not beyond it";
+    auto h = build_hierarchy(two_spheres(), "rc5d", {"max_bytes=68719476736"});
+    EXPECT_EQ(as_rc5d(*h).options().max_bytes, half);
+    EXPECT_EQ(as_rc5d(*h).options().asked_max_bytes, std::uint64_t{1} << 36);
 }
 
 TEST(Rc5dBuild, EmptyAndFlatScenes) {

@@ -8,6 +8,8 @@
 #include <deque>
 #include <numeric>
 
+#include <unistd.h>
+
 namespace rtcost::rc5d {
 namespace {
 
@@ -185,9 +187,12 @@ void Rc5d::build_eager() {
 StructureStats Rc5d::compute_structure() const {
     StructureStats s;
     if (capped_.load(std::memory_order_relaxed))
-        s.limits.push_back(fmt::format("rc5d: subdivision stopped at the memory cap max_bytes={}; beams below it hold "
+        s.limits.push_back(fmt::format("rc5d: subdivision stopped at the memory cap max_bytes={}{}; beams below it hold "
                                        "more candidates than max_prims",
-                                       opt_.max_bytes));
+                                       opt_.max_bytes,
+                                       opt_.asked_max_bytes ? fmt::format(" (half this machine's memory; {} was asked)",
+                                                                          opt_.asked_max_bytes)
+                                                            : ""));
     s.interior = 1;  // the cube selection: the root every classified ray passes
     std::uint64_t nodes = 0;
     std::vector<std::pair<const Node*, int>> stack;
@@ -295,6 +300,13 @@ const Registration reg{
          o.max_depth = static_cast<int>(p.integer("max_depth"));
          o.lazy = p.is("build", "lazy");
          o.max_bytes = static_cast<std::uint64_t>(p.integer("max_bytes"));
+         // A cap beyond the machine's memory bounds nothing: the build would end out of memory
+         // before reaching it. Half the physical memory at most.
+         const long pages = ::sysconf(_SC_PHYS_PAGES), page = ::sysconf(_SC_PAGESIZE);
+         if (pages > 0 && page > 0) {
+             const std::uint64_t half = static_cast<std::uint64_t>(pages) * static_cast<std::uint64_t>(page) / 2;
+             if (o.max_bytes > half) o.asked_max_bytes = o.max_bytes, o.max_bytes = half;
+         }
          return std::make_unique<Rc5d>(s, o);
      }},
     {{{}, kTestHits},

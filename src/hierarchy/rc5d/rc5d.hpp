@@ -60,6 +60,9 @@ struct Options {
     int max_depth = 30;
     bool lazy = true;    ///< subdivide on the first visit (true) or all at build time
     std::uint64_t max_bytes = std::uint64_t{1} << 30;  ///< memory cap stopping subdivision (>= 1)
+    /// The cap asked for where it was lowered to half the machine's memory (0: max_bytes was
+    /// asked), so that the structure's limits say so if the lower cap stops the subdivision.
+    std::uint64_t asked_max_bytes = 0;
 };
 
 /// A 5D hypercube: dimensions 0..2 the origin box, 3 = u, 4 = v.
