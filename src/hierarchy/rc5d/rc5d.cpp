@@ -292,8 +292,8 @@ const Registration reg{
                         "at build time"),
       ParamSpec::integer("max_bytes", "1073741824", 1, 1LL << 36,
                          "memory cap in bytes: subdivision stops where the structure would exceed it (a bound always "
-                         "holds, as eager builds grow exponentially); with a cap that is reached, lazy and eager "
-                         "trees can differ")},
+                         "holds, as eager builds grow exponentially; at most half the machine's memory); with a cap "
+                         "that is reached, lazy and eager trees can differ")},
      [](const Scene& s, const Params& p) {
          Options o;
          o.max_prims = static_cast<int>(p.integer("max_prims"));
