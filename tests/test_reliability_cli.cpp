@@ -166,6 +166,17 @@ TEST(ReliabilityCli, ASampleOfAnotherSceneStopsEvalBeforeAnyOutput) {
         EXPECT_EQ(r.out, "") << other << ": stdout before the error";
     }
     EXPECT_EQ(rtcost("eval builtin:tetra:2 -H bvh-sah --rays lines --count 2000 --estimator segments -q --sample-file " + smp).code, 0);
+    // A version-1 file has no fingerprint: a primitive id beyond the scene is what tells, and
+    // the error names the file (it said "sample").
+    std::string v1 = slurp(smp);
+    ASSERT_EQ(v1[8], 3);
+    v1[8] = 1;
+    v1.erase(8 + 4 + 4 + 4 * 8, 8);
+    const std::string old_file = file("tetra-v1.sample", v1).string();
+    const CliResult r = rtcost("eval builtin:balls:1 -H bvh-sah --rays lines --count 2000 --estimator segments --sample-file " +
+                               old_file);
+    EXPECT_BAD_INPUT(r, old_file + ": primitive ");
+    EXPECT_TRUE(has(r.err, "is not in the scene")) << r.err;
 }
 
 TEST(ReliabilityCli, PlyWithoutEndHeaderEndsWithAnError) {

@@ -33,6 +33,10 @@ struct RaySample {
     std::uint64_t scene = 0;
     /// The version of the sample file it was read from; 0: drawn, not read.
     std::uint32_t file_version = 0;
+    /// The file it was read from (what errors about it name); empty: drawn, not read.
+    std::string path;
+    /// What an error about this sample names: its file, or "sample" for one drawn.
+    std::string source() const { return path.empty() ? "sample" : path; }
 
     std::size_t size() const { return rays.rays.size(); }
     std::span<const Crossing> crossings_of(std::size_t i) const {

@@ -97,6 +97,7 @@ RaySample read_sample(const std::string& path) {
     s.population = population;
     s.scene = scene;
     s.file_version = version;
+    s.path = path;
     s.distribution.assign(b.data() + at, text);
     at += text;
     s.rays.described = s.distribution + " (sample)";

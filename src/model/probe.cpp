@@ -24,7 +24,7 @@ public:
         for (std::uint32_t i : index)
             for (const Crossing& c : sample.crossings_of(i))
                 if (c.prim >= s.size())
-                    throw InputError("sample", 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
+                    throw InputError(sample.source(), 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
                                                       std::to_string(s.size()) + " primitives): a sample of another scene?");
     }
     /// Ray `i` of the probe's rays starts.

@@ -365,7 +365,7 @@ Prediction SegmentsPredictor::predict(std::span<const std::uint32_t> rays, const
             if (i >= sample_.size()) throw std::out_of_range("predict_segments: ray index beyond the sample");
             for (const Crossing& c : sample_.crossings_of(i))  // as the model tree's probe refuses it
                 if (c.prim >= scene_.size())
-                    throw InputError("sample", 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
+                    throw InputError(sample_.source(), 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
                                                       std::to_string(scene_.size()) +
                                                       " primitives): a sample of another scene?");
         }
