@@ -211,6 +211,15 @@ TRIED = ["", "## Tried and not kept", "",
          "same cuts): 98% of the node work on balls' shadow rays, 93-96% on sombrero, 57-76% on rings, "
          "12-34% on mount, 10% on lattice and teapot, so memoising across them saves least where the counts "
          "design different trees. None kept: the held-out choice stays within a quarter point of the oracle.",
+         "- Taken up on 2026-12-08: 32 candidates by default, the held-out choice (`--set candidates=auto`) "
+         "an option. Measured with `rtcost eval -H bvh-sah,bvh-design:rays=D,bvh-design:rays=D:candidates=32` "
+         "(segments estimator, one core) on the 60 bvh rows' scenes and distributions: the design within 10x "
+         "bvh-sah's build on 40 of 60 rows (auto: 1; the 20 left are the small scenes, shells, sombrero, "
+         "tetra and some of lattice and rings, where drawing the 4,096-ray sample alone is several bvh-sah "
+         "builds), for +8.34% operations against bvh-sah on average (auto: +8.77%); shadow rays at least "
+         "20% fewer on the same three scenes, ao on the same two; rows that lost most: teapot diffuse "
+         "+19.3% -> +15.3%, tree camera +13.1% -> +9.7%, balls diffuse +3.1% -> +0.1%; gained most: balls "
+         "spd -4.4% -> +1.5%.",
          ]
 
 
