@@ -220,6 +220,13 @@ TRIED = ["", "## Tried and not kept", "",
          "20% fewer on the same three scenes, ao on the same two; rows that lost most: teapot diffuse "
          "+19.3% -> +15.3%, tree camera +13.1% -> +9.7%, balls diffuse +3.1% -> +0.1%; gained most: balls "
          "spd -4.4% -> +1.5%.",
+         "- 2026-12-08, for design time, bvh-design's occlusion order bytes priced from each ray's walk "
+         "recorded once (the nodes a ray meets do not depend on the orders, so each later sweep only adds "
+         "the recorded costs up again: the same bytes on 15 scene and distribution pairs, and with the "
+         "walk at each sweep). Callgrind: the pricing's instructions on lattice's shadow rays halved (156 M "
+         "to 80 M), the design's fell 16%; but its wall time rose, 9.7-10.2 ms to 23-31 ms for one tree's "
+         "pricing (one core): the 150,000 recorded steps (2.4 MB, written into fresh memory as the vector "
+         "grew) cost more in page faults on this VM than the three walks they saved. Not kept.",
          ]
 
 
