@@ -84,6 +84,14 @@ json read_eval(const std::string& path, const Scene& scene) {
                          fmt::format("an evaluation of {} ({} primitives), not of {} ({} primitives)",
                                      j.value("scene", std::string("another scene")), j["primitives"].get<std::uint64_t>(),
                                      scene.name, scene.size()));
+    // The same count of primitives is not the same scene (tetra at another level, an edited
+    // file): the fingerprint tells, where the document has one (eval's since 2026-12-08).
+    if (j.contains("scene_fingerprint") && j["scene_fingerprint"].is_string() &&
+        j["scene_fingerprint"].get<std::string>() != fmt::format("{:016x}", scene.fingerprint()))
+        throw InputError(path, 0,
+                         fmt::format("an evaluation of {}, not of {}: the scenes differ (fingerprints {} and {:016x})",
+                                     j.value("scene", std::string("another scene")), scene.name,
+                                     j["scene_fingerprint"].get<std::string>(), scene.fingerprint()));
     return j;
 }
 

@@ -192,6 +192,23 @@ TEST(CliOutputs, AReportOfAnotherScenesEvaluationIsRefused) {
     EXPECT_EQ(r.code, 2);
     EXPECT_TRUE(has(r.err, "an evaluation of builtin:balls:3 (821 primitives), not of builtin:tetra:3 (64 primitives)"))
         << r.err;
+    // As many primitives, another scene (the same file with its sphere moved): the fingerprint
+    // tells them apart; the scene evaluated itself is reported.
+    const fs::path scene = write("fp.nff", kScene);
+    std::string moved = kScene;
+    moved.replace(moved.find("s 0 0 0 1"), 9, "s 0 0.5 0 1");
+    const fs::path other = write("fp-moved.nff", moved);
+    e = run_cli("eval " + scene.string() + " -H bvh-sah --size 8x8 -q --json");
+    ASSERT_EQ(e.code, 0) << e.err;
+    std::ofstream(eval) << e.out;
+    r = run_cli("report " + other.string() + " --from-eval " + eval.string() + " --no-design -q -o " +
+                (dir() / "x.html").string());
+    EXPECT_EQ(r.code, 2);
+    EXPECT_TRUE(has(r.err, "not of " + other.string() + ": the scenes differ")) << r.err;
+    EXPECT_FALSE(fs::exists(dir() / "x.html"));
+    r = run_cli("report " + scene.string() + " --from-eval " + eval.string() + " --no-design -q -o " +
+                (dir() / "x.html").string());
+    EXPECT_EQ(r.code, 0) << r.err;
 }
 
 TEST(CliOutputs, ASceneResolutionBeyondTheRayLimitNeedsASize) {

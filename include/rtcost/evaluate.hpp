@@ -119,6 +119,7 @@ struct EvalRow {
 struct EvalResult {
     std::string scene;
     std::size_t primitives = 0;
+    std::uint64_t scene_fingerprint = 0;  ///< Scene::fingerprint(): which scene it evaluated
     std::string distribution;          ///< RaySet::described
     std::size_t test_rays = 0, training_rays = 0;
     std::size_t sample_rays = 0;       ///< the segments estimator's sample (disjoint from the test rays)

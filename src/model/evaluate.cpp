@@ -109,6 +109,7 @@ EvalResult run(const Scene& scene, RaySet test, const RaySet& train, const RaySa
     EvalResult res;
     res.scene = scene.name;
     res.primitives = scene.size();
+    res.scene_fingerprint = scene.fingerprint();
     res.distribution = test.described;
     res.test_rays = test.rays.size();
     res.training_rays = train.rays.size();
