@@ -86,12 +86,12 @@ json read_eval(const std::string& path, const Scene& scene) {
                                      scene.name, scene.size()));
     // The same count of primitives is not the same scene (tetra at another level, an edited
     // file): the fingerprint tells, where the document has one (eval's since 2026-12-08).
-    if (j.contains("scene_fingerprint") && j["scene_fingerprint"].is_string() &&
-        j["scene_fingerprint"].get<std::string>() != fmt::format("{:016x}", scene.fingerprint()))
+    const std::string mine = fingerprint_text(scene.fingerprint());
+    if (j.contains("scene_fingerprint") && j["scene_fingerprint"].is_string() && j["scene_fingerprint"] != mine)
         throw InputError(path, 0,
-                         fmt::format("an evaluation of {}, not of {}: the scenes differ (fingerprints {} and {:016x})",
+                         fmt::format("an evaluation of {}, not of {}: the scenes differ (fingerprints {} and {})",
                                      j.value("scene", std::string("another scene")), scene.name,
-                                     j["scene_fingerprint"].get<std::string>(), scene.fingerprint()));
+                                     j["scene_fingerprint"].get<std::string>(), mine));
     return j;
 }
 

@@ -115,6 +115,10 @@ struct EvalRow {
     const Prediction* headline() const { return predictions.empty() ? nullptr : &predictions.front(); }
 };
 
+/// A scene fingerprint as `eval --json` writes it (`scene_fingerprint`: 16 hex digits, a JSON
+/// number losing bits beyond 2^53 in most readers).
+std::string fingerprint_text(std::uint64_t fingerprint);
+
 /// Everything `rtcost eval` reports.
 struct EvalResult {
     std::string scene;

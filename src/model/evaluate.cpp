@@ -11,6 +11,8 @@
 #include <optional>
 #include <stdexcept>
 
+#include <fmt/format.h>
+
 #include "rtcost/error.hpp"
 #include "rtcost/sample.hpp"
 #include "rtcost/trace.hpp"
@@ -18,6 +20,8 @@
 #include "util/rng.hpp"
 
 namespace rtcost {
+
+std::string fingerprint_text(std::uint64_t fingerprint) { return fmt::format("{:016x}", fingerprint); }
 
 namespace {
 

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "rtcost/error.hpp"
 #include "rtcost/model.hpp"
 #include "rtcost/sample.hpp"
 
@@ -120,6 +121,19 @@ std::vector<NodeProbabilities> segment_probabilities(const ModelTree& t, const S
 /// Thrown by a probe that enters a node left out of a reached tree (SegmentsPredictor then
 /// predicts on the whole tree).
 struct PrunedNodeReached {};
+
+/// Refuses `sample` when a crossing of one of its rays `rays` names a primitive beyond the
+/// scene's `primitives` (a sample of another scene, which a version-1 file's missing
+/// fingerprint cannot tell): InputError naming the sample's file.
+inline void check_crossings_in_scene(const RaySample& sample, std::span<const std::uint32_t> rays,
+                                     std::size_t primitives) {
+    for (std::uint32_t i : rays)
+        for (const Crossing& c : sample.crossings_of(i))
+            if (c.prim >= primitives)
+                throw InputError(sample.source(), 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
+                                                         std::to_string(primitives) +
+                                                         " primitives): a sample of another scene?");
+}
 
 /// The segments estimator's answer to a test of primitive `id` by a ray whose known crossings
 /// (nearest first) are `known`: a crossing nearer than the hit so far and before tmax is

@@ -21,11 +21,7 @@ public:
     explicit PrimOracle(const Scene& s) : s_(s) {}
     PrimOracle(const Scene& s, const RaySample& sample, std::span<const std::uint32_t> index)
         : s_(s), sample_(&sample), index_(index) {
-        for (std::uint32_t i : index)
-            for (const Crossing& c : sample.crossings_of(i))
-                if (c.prim >= s.size())
-                    throw InputError(sample.source(), 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
-                                                      std::to_string(s.size()) + " primitives): a sample of another scene?");
+        check_crossings_in_scene(sample, index, s.size());
     }
     /// Ray `i` of the probe's rays starts.
     void begin(std::size_t i) {

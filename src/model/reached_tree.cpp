@@ -361,14 +361,9 @@ Prediction SegmentsPredictor::predict(std::span<const std::uint32_t> rays, const
     // nearest hit so far, where the model tree's probe walks them to the segment's end. Nor no
     // rays at all: the model tree still charges each ray the root's test.)
     if (via_ == Via::Traversal && opt.preset == Preset::Exact && opt.query != Query::All && !rays.empty()) {
-        for (std::uint32_t i : rays) {
+        for (std::uint32_t i : rays)
             if (i >= sample_.size()) throw std::out_of_range("predict_segments: ray index beyond the sample");
-            for (const Crossing& c : sample_.crossings_of(i))  // as the model tree's probe refuses it
-                if (c.prim >= scene_.size())
-                    throw InputError(sample_.source(), 0, "primitive " + std::to_string(c.prim) + " is not in the scene (" +
-                                                      std::to_string(scene_.size()) +
-                                                      " primitives): a sample of another scene?");
-        }
+        model::check_crossings_in_scene(sample_, rays, scene_.size());  // as the model tree's probe refuses it
         RayCounters counters;
         try {
             if (h_.replay(sample_, rays, opt.query, counters)) return replayed(counters, rays.size(), costs);

@@ -88,7 +88,7 @@ nlohmann::json to_json(const EvalResult& r, bool by_depth) {
     }
     return {{"scene", r.scene},
             {"primitives", r.primitives},
-            {"scene_fingerprint", fmt::format("{:016x}", r.scene_fingerprint)},
+            {"scene_fingerprint", fingerprint_text(r.scene_fingerprint)},
             {"rays", r.test_rays},
             {"distribution", r.distribution},
             {"query", query_name(r.query)},
